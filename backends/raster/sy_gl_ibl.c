@@ -73,14 +73,14 @@ static const char *const prefilter_fs =
  *  hemisphere sampling (256 Hammersley points), at most 1; sy_gl_shaders_layers.c reads it.
  * The sample directions depend on the sample's index alone: computed once, in float as the shader
  * did. */
-static float radinv(uint32_t b)
+/* The radical inverse of i in base 2 (van der Corput), digit by digit: exact in float for the
+ * tables' few hundred indices, the same values as the shaders' bit-reversing radinv. */
+static float radinv(uint32_t i)
 {
-    b = (b << 16u) | (b >> 16u);
-    b = ((b & 0x55555555u) << 1u) | ((b & 0xAAAAAAAAu) >> 1u);
-    b = ((b & 0x33333333u) << 2u) | ((b & 0xCCCCCCCCu) >> 2u);
-    b = ((b & 0x0F0F0F0Fu) << 4u) | ((b & 0xF0F0F0F0u) >> 4u);
-    b = ((b & 0x00FF00FFu) << 8u) | ((b & 0xFF00FF00u) >> 8u);
-    return (float)b * 2.3283064365386963e-10f;
+    float v = 0.0f;
+    for (float f = 0.5f; i; i >>= 1, f *= 0.5f)
+        if (i & 1u) v += f;
+    return v;
 }
 
 #define BRDF_GGX_SAMPLES 512u

@@ -94,6 +94,12 @@ for_tracers() {
         "$2"
     done
 }
+# pan_widths BLURRED SUB-FRAMES SHARP: the panned box's widths in px (wb blurred, ws as sub-frames, wm
+# sharp) and the blurred image's relMSE against the sub-frames (rel)
+pan_widths() {
+    wb=$("$EXR_BLUR" width 0.02 "$1") ws=$("$EXR_BLUR" width 0.02 "$2") wm=$("$EXR_BLUR" width 0.5 "$3")
+    rel=$("$EXR_BLUR" relmse "$1" "$2")
+}
 mean_alpha() { # mean_alpha FILE: the mean alpha of the EXR render FILE
     local a
     read -r _ _ _ a <<<"$("$EXR_BLUR" mean "$1")"
@@ -253,10 +259,7 @@ camera_checks() {
     c pan mid --at 0.5
     c pan two --at 0.25 --shutter 0,0.5 --shutter-steps 2
     "$EXR_EQUAL" "$TMP/${b}_cam_blur.exr" "$TMP/${b}_cam_two.exr" >/dev/null || fail "$b: a 5.7-degree pan's default differs from --shutter-steps 2"
-    wb=$("$EXR_BLUR" width 0.02 "$TMP/${b}_cam_blur.exr")
-    ws=$("$EXR_BLUR" width 0.02 "$TMP/${b}_cam_sub.exr")
-    wm=$("$EXR_BLUR" width 0.5 "$TMP/${b}_cam_mid.exr")
-    rel=$("$EXR_BLUR" relmse "$TMP/${b}_cam_blur.exr" "$TMP/${b}_cam_sub.exr")
+    pan_widths "$TMP/${b}_cam_blur.exr" "$TMP/${b}_cam_sub.exr" "$TMP/${b}_cam_mid.exr"
     echo "$b panning camera: box width $wm px sharp, $wb px blurred in one render, $ws px as 64 sub-frames (blur 12.53 px);" \
         "relMSE against the sub-frames $rel"
     near "$(awk -v a="$wb" -v b="$wm" 'BEGIN { print a - b }')" 12.53 1.0 ||
@@ -317,10 +320,7 @@ stereo_checks() {
     max_rel=0.002
     [ "$b" = pathtracer ] && max_rel=0.01
     for eye in left right; do
-        wb=$("$EXR_BLUR" width 0.02 "$TMP/${b}_cam_st_blur_$eye.exr")
-        ws=$("$EXR_BLUR" width 0.02 "$TMP/${b}_cam_st_sub_$eye.exr")
-        wm=$("$EXR_BLUR" width 0.5 "$TMP/${b}_cam_st_mid_$eye.exr")
-        rel=$("$EXR_BLUR" relmse "$TMP/${b}_cam_st_blur_$eye.exr" "$TMP/${b}_cam_st_sub_$eye.exr")
+        pan_widths "$TMP/${b}_cam_st_blur_$eye.exr" "$TMP/${b}_cam_st_sub_$eye.exr" "$TMP/${b}_cam_st_mid_$eye.exr"
         echo "$b panning camera, $eye eye: box width $wm px sharp, $wb px blurred in one render, $ws px as 64 sub-frames;" \
             "relMSE against the sub-frames $rel"
         gt "$(awk -v a="$wb" -v b="$wm" 'BEGIN { print a - b }')" 8 || fail "$b stereo $eye eye: no blur ($wb px, sharp $wm px)"
