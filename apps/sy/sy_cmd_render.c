@@ -802,7 +802,7 @@ int sy_cmd_render(int argc, char **argv)
         SY_CLI_OPT_TEXT("gl", OPT_GL, &gl_provider),          /* raster: gl=... parameter */
         SY_CLI_OPT_TEXT("filter", OPT_FILTER, &filter),       /* pathtracer: filter=... */
         SY_CLI_OPT_TEXT("threshold", OPT_THRESHOLD, &threshold), /* pathtracer: threshold=... */
-        SY_CLI_OPT_FLAG("temporal", OPT_TEMPORAL, &temporal),     /* pathtracer: temporal=1 (a moving camera's frames) */
+        SY_CLI_OPT_FLAG("temporal", OPT_TEMPORAL, &temporal),     /* pathtracer: temporal=1 (moving frames: camera or objects) */
         SY_CLI_OPT_FLAG("half", OPT_HALF, &oo.half), SY_CLI_OPT_FLOAT("exposure", OPT_EXPOSURE, &oo.png.exposure_stops, -FLT_MAX, FLT_MAX),
         SY_CLI_OPT_CODE("tonemap", OPT_TONEMAP, true), SY_CLI_OPT_CODE("stereo", OPT_STEREO, true),
         SY_CLI_OPT_FLOAT_ANY("eye-sep", OPT_EYE_SEP, &spec.eye_separation), /* the range: sy_compose says why */

@@ -34,6 +34,9 @@ static void rt_destroy(void *state)
     sy_mirror_map_free(&st->motion_rec);
     sy_mirror_map_free(&st->inst_sel);
     sy_mirror_map_free(&st->inst_place);
+    sy_mirror_map_free(&st->temporal_from);
+    free(st->motion_ids);
+    free(st->motion_buf);
     free(st);
 }
 
@@ -66,6 +69,7 @@ static sy_result rt_create_common(const sy_mediator_create_args *args, uint32_t 
     st->motion_steps = 2;
     st->inst_sel = SY_MIRROR_MAP_INIT(uint8_t);
     st->inst_place = SY_MIRROR_MAP_INIT(uint32_t);
+    st->temporal_from = SY_MIRROR_MAP_INIT(rt_move_rec);
     sy_rt_device_desc dd = sy_rti_device_desc(st, (uint32_t)threads, (uint64_t)max_memory_mb << 20);
     sy_rt_result rr = sy_rt_device_create(&dd, &st->dev);
     if (rr != SY_RT_OK) {

@@ -114,6 +114,13 @@ uint32_t sy_mediator_rt_aov_channels(uint32_t index);  /**< 4, 3, 3, 3, 1, 3, 3 
  *   (sy_filter_temporal_rest: no pop when the camera stops; a camera that never moved, or 64
  *   samples on, is the accumulation bit for bit). sy view and sy web set it
  *   (sy_interactive_set_temporal); turning it off forgets the history.
+ *   temporal_motion=0|1 (default 1): temporal reuse follows moving instances: a sync that changed
+ *   only instance transforms (or visibility, or deformed vertices) since the previous render makes
+ *   that render a moving frame under a still camera too (instead of restarting the history), and
+ *   every moving frame gives the filter per-pixel object motion (the instance under each pixel
+ *   centre, sy_rt_coverage, and M_prev M_now^-1 p - p at its world position p; deformed meshes and
+ *   unmoved instances 0). 0: the camera's motion alone, as before (the baseline of
+ *   tests/integration/test_pathtracer_motion.c).
  * sy_mediator_rt_set_filter changes it live: name (NULL = opts' "filter" or unchanged) and the keys
  * present in opts (NULL = none; absent keys keep their values). Only the threshold keeps the pixel
  * filter's filtered buffer; any other change recomputes it at the next frame. On error nothing
@@ -134,13 +141,17 @@ typedef struct sy_mediator_rt_filter_info {
                                    share of pixels in the correction phase (plain path tracing) */
     uint32_t last_pass_samples; /**< pixel: sample count of the last filter pass (0 = none yet) */
     bool temporal;              /**< the "temporal" parameter: reuse on frames whose camera moved */
-    bool temporal_last;         /**< the last render showed the temporal estimate (its camera moved) */
+    bool temporal_last;         /**< the last render showed the temporal estimate (its camera or, with
+                                     temporal_motion, only its instances moved) */
     uint64_t temporal_frames;   /**< frames that showed the temporal estimate so far */
     double temporal_seconds;    /**< the last such frame's temporal stage (AOV read + filter), wall time */
     double temporal_filter_cpu_seconds; /**< of it: the filter's CPU time (all threads; sy_filter_temporal_stats) */
     double temporal_reused;     /**< the last such frame: share of hit pixels with a reprojected history */
     bool temporal_rest_last;    /**< the last render rested after moving frames: the accumulation blended
                                      with the last estimate (sy_filter_temporal_rest) */
+    double temporal_motion_seconds;  /**< the last render: wall time of its object motion (coverage rays + the
+                                          per-pixel motion), 0 when no instance moved */
+    uint64_t temporal_moving_pixels; /**< the last render: pixels given a non-zero object motion */
 } sy_mediator_rt_filter_info;
 /** Fills *out with the context's filter state. */
 void sy_mediator_rt_filter_info_get(void *state, sy_mediator_rt_filter_info *out);

@@ -74,6 +74,10 @@ const sy_param_decl sy_rti_pathtracer_params[] = {
      "temporal reuse while the camera moves (sy_filter_temporal.h): a frame whose camera moved since the last "
      "one shows the reprojected history blended with its samples and a-trous filtered; a still camera shows the "
      "accumulation unchanged (sy view and sy web turn it on)", LIVE},
+    {"temporal_motion", SY_PARAM_BOOL, 0, 0, "1", NULL,
+     "temporal reuse: follow moving instances (per-pixel object motion from their transforms at the last "
+     "render; 0 = camera motion only, the comparison's baseline); with it, a still camera whose scene changed "
+     "only by moves also reuses the history", LIVE},
 };
 #undef LIVE
 const sy_param_table sy_rti_whitted_table = SY_PARAM_TABLE(sy_rti_whitted_params);

@@ -16,7 +16,8 @@ static const char *const pt_filter_names[PT_FILTER_KIND_COUNT] = {"none", "pixel
  * The path tracer's layer can be filtered for display (backends/filters) from the accumulation's
  * feature buffers. Parameters (creation and sy_mediator_rt_set_filter): filter, threshold, sigma_s,
  * sigma_c, sigma_d, filter_kernel, filter_iterations, filter_start, atrous_iterations, jbu_factor,
- * temporal (temporal reuse on frames whose camera moved: sy_rti_temporal_layer below). */
+ * temporal (temporal reuse on frames whose camera moved: sy_rti_temporal_layer below), temporal_motion
+ * (and on frames whose instances moved, following them). */
 /* Every code a filter returns has core's number (the cast in sy_backend_fail). */
 SY_BACKEND_SAME_CODE(SY_FILTER_ERROR_INVALID_ARGUMENT, SY_ERR_INVALID_ARGUMENT);
 SY_BACKEND_SAME_CODE(SY_FILTER_ERROR_OUT_OF_MEMORY, SY_ERR_OUT_OF_MEMORY);
@@ -30,6 +31,7 @@ void sy_rti_filter_cfg_default(pt_filter_cfg *c, uint32_t threads)
 {
     memset(c, 0, sizeof *c);
     c->kind = PT_FILTER_NONE;
+    c->temporal_motion = true;
     sy_filter_pixel_params_default(&c->pixel);
     sy_filter_atrous_params_default(&c->atrous);
     sy_filter_jbu_params_default(&c->jbu);
@@ -118,7 +120,8 @@ sy_result sy_rti_filter_cfg_apply(pt_filter_cfg *base, const char *name, const s
         (r = pt_u32(p, all, "filter_start", &c.pixel.schedule_start, err)) ||
         (r = pt_u32(p, all, "atrous_iterations", &c.atrous.iterations, err)) ||
         (r = pt_u32(p, all, "jbu_factor", &c.jbu.factor, err)) || (r = radiance_cfg_apply(&c.radiance, p, all, err)) ||
-        (r = pt_bool(p, all, "temporal", &c.temporal, err)))
+        (r = pt_bool(p, all, "temporal", &c.temporal, err)) ||
+        (r = pt_bool(p, all, "temporal_motion", &c.temporal_motion, err)))
         return r;
     c.pixel.threshold = c.adaptive.threshold = c.radiance.threshold = threshold;
     c.pixel.kernel = fkernel ? SY_FILTER_PIXEL_BRUTE : SY_FILTER_PIXEL_SEPARABLE;
@@ -171,6 +174,7 @@ sy_result sy_mediator_rt_set_filter(void *state, const char *name, const sy_para
     if (!c.temporal) { /* off: the next time it is turned on starts from nothing */
         sy_filter_temporal_reset(st->temporal);
         st->temporal_have_cam = false;
+        sy_mirror_map_free(&st->temporal_from); /* and no moves are recorded while it is off */
     }
     st->filter = c;
     return SY_OK;
@@ -331,16 +335,113 @@ static bool world_to_pixel(const sy_render_request *req, float out[16])
     return true;
 }
 
+/* Whether the device changed since the last render only by moves (sy_rti_sync's run of versions
+ * move_from .. move_to), and temporal_motion follows them. */
+static bool objects_moved(const rt_state *st)
+{
+    sy_rt_stats ds;
+    sy_rt_device_stats(st->dev, &ds);
+    return st->filter.temporal_motion && st->temporal_have_cam && ds.version != st->temporal_version &&
+           ds.version == st->move_to && st->temporal_version >= st->move_from;
+}
+
+bool sy_rti_temporal_moving(const rt_state *st, const sy_render_request *req)
+{
+    if (!st->filter.temporal || !st->temporal_have_cam) return false;
+    return !sy_rti_same_view(&st->temporal_cam, &req->camera) || objects_moved(st);
+}
+
+/* >>object motion
+ * The per-pixel motion of this render's first hits (sy_filter_frame.motion, q = p + motion): which
+ * instance each pixel centre's camera ray hits (sy_rt_coverage: one ray per pixel, the ray of the ID
+ * AOVs), and for an instance moved since the last render (st->temporal_from, recorded by the sync)
+ * motion = M_prev M_now^-1 p - p at the pixel's world position p (the filter's, from the mean
+ * depth). Instances not moved, misses and deformed meshes (vertices moved under a still transform)
+ * get 0: their history is rejected where the surface left the depth or normal tolerance, or
+ * clamped. An instance whose matrix cannot be inverted gets NaN (no history). *any false (no
+ * motion plane: the camera's motion alone) when no instance moved; *pixels counts the pixels that moved. */
+static sy_result object_motion(rt_state *st, const sy_render_request *req, const float *pos, bool *any,
+                               uint64_t *pixels, sy_error *err)
+{
+    *any = false, *pixels = 0;
+    if (!st->filter.temporal_motion || !st->temporal_from.live) return SY_OK;
+    size_t n = (size_t)req->rect_w * req->rect_h;
+    if (n > st->motion_px) {
+        free(st->motion_ids), free(st->motion_buf);
+        st->motion_ids = malloc(n * sizeof *st->motion_ids);
+        st->motion_buf = malloc(n * 3 * sizeof *st->motion_buf);
+        st->motion_px = st->motion_ids && st->motion_buf ? n : 0;
+        if (!st->motion_px)
+            return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "pathtracer temporal: out of memory for the motion of %ux%u",
+                                req->rect_w, req->rect_h);
+    }
+    const sy_rt_render_desc *ld = &st->last_desc; /* this render's camera and rectangle */
+    sy_rt_render_desc d = {.image_width = ld->image_width, .image_height = ld->image_height, .x = ld->x, .y = ld->y,
+                           .width = ld->width, .height = ld->height};
+    sy_rt_result rr = sy_rt_coverage(st->dev, &st->last_cam, &d, st->motion_ids, NULL);
+    if (rr != SY_RT_OK) return sy_rti_fail(st, err, rr, "pathtracer temporal: object motion");
+    float *mv = st->motion_buf;
+    uint32_t last_id = 0;
+    const rt_move_rec *mr = NULL;
+    for (size_t i = 0; i < n; ++i) {
+        uint32_t id = st->motion_ids[i];
+        if (id != last_id) {
+            last_id = id;
+            rt_move_rec *r = id ? sy_mirror_map_get(&st->temporal_from, id) : NULL;
+            if (r && !r->ready) { /* to_prev = prev now^-1, NaN when now has no inverse */
+                sy_mat4 now, inv, prev, tp;
+                r->ready = true;
+                if (sy_rt_instance_get_transform(st->dev, (sy_rt_instance){id}, now.m) == SY_RT_OK &&
+                    sy_mat4_invert(&now, &inv)) {
+                    memcpy(prev.m, r->prev, sizeof prev.m);
+                    tp = sy_mat4_mul(&prev, &inv);
+                    memcpy(r->to_prev, tp.m, sizeof tp.m);
+                } else {
+                    for (int k = 0; k < 16; ++k) r->to_prev[k] = NAN;
+                }
+            }
+            mr = r;
+        }
+        float *o = mv + 3 * i;
+        if (!mr) {
+            o[0] = o[1] = o[2] = 0.0f;
+            continue;
+        }
+        const float *p = pos + 3 * i, *m = mr->to_prev;
+        for (int k = 0; k < 3; ++k) o[k] = m[k] * p[0] + m[4 + k] * p[1] + m[8 + k] * p[2] + m[12 + k] - p[k];
+        if (o[0] != 0.0f || o[1] != 0.0f || o[2] != 0.0f) ++*pixels;
+    }
+    *any = true;
+    return SY_OK;
+}
+
+static sy_result temporal_frame(rt_state *st, const sy_render_request *req, uint32_t samples, bool moved,
+                                sy_layer *layer, bool *done, sy_error *err);
+
 sy_result sy_rti_temporal_layer(rt_state *st, const sy_render_request *req, uint32_t samples, sy_layer *layer,
                                 bool *done, sy_error *err)
 {
     *done = false;
     st->finfo.temporal_last = false, st->finfo.temporal_rest_last = false;
     st->temporal_rest = false;
+    st->finfo.temporal_motion_seconds = 0.0, st->finfo.temporal_moving_pixels = 0;
     if (!st->filter.temporal) return SY_OK;
-    bool moved = st->temporal_have_cam && !sy_rti_same_view(&st->temporal_cam, &req->camera);
+    bool objects = objects_moved(st);
+    bool moved = st->temporal_have_cam && (!sy_rti_same_view(&st->temporal_cam, &req->camera) || objects);
     st->temporal_cam = req->camera;
     st->temporal_have_cam = true;
+    sy_rt_stats ds;
+    sy_rt_device_stats(st->dev, &ds);
+    st->temporal_version = ds.version;
+    sy_result r = temporal_frame(st, req, samples, moved, layer, done, err);
+    /* this render's transforms are the next one's previous ones */
+    if (st->temporal_from.live) sy_mirror_map_free(&st->temporal_from);
+    return r;
+}
+
+static sy_result temporal_frame(rt_state *st, const sy_render_request *req, uint32_t samples, bool moved,
+                                sy_layer *layer, bool *done, sy_error *err)
+{
     accum_slot *a = &st->slots[st->last_slot];
     if (!moved && st->temporal) {
         /* a still camera: an accumulation that continues blends with the last estimate; one that
@@ -367,6 +468,15 @@ sy_result sy_rti_temporal_layer(rt_state *st, const sy_render_request *req, uint
     sy_filter_frame f;
     sy_result rd = read_frame(st, a, req, samples, &f, err);
     if (rd != SY_OK) return rd;
+    struct timespec tm0, tm1;
+    clock_gettime(CLOCK_MONOTONIC, &tm0);
+    bool any = false;
+    uint64_t moving = 0;
+    if ((rd = object_motion(st, req, f.position, &any, &moving, err)) != SY_OK) return rd;
+    if (any) f.motion = st->motion_buf;
+    clock_gettime(CLOCK_MONOTONIC, &tm1);
+    st->finfo.temporal_motion_seconds = any ? (double)(tm1.tv_sec - tm0.tv_sec) + 1e-9 * (double)(tm1.tv_nsec - tm0.tv_nsec) : 0.0;
+    st->finfo.temporal_moving_pixels = moving;
     sy_filter_temporal_stats ts = {0};
     if (sy_filter_temporal_run(st->temporal, &f, m, layer->rgba, &ts, &fe)) return filter_fail(err, &fe);
     clock_gettime(CLOCK_MONOTONIC, &t1);

@@ -67,13 +67,22 @@ typedef struct pt_filter_cfg {
     sy_filter_jbu_params jbu;
     sy_filter_adaptive_params adaptive;
     sy_filter_radiance_params radiance; /* threshold T_u = the shared threshold */
-    bool temporal;                      /* "temporal": reuse on frames whose camera moved */
+    bool temporal;                      /* "temporal": reuse on frames whose camera or objects moved */
+    bool temporal_motion;               /* "temporal_motion": object motion for the reprojection */
 } pt_filter_cfg;
 
 /* The scene mirror (textures, materials, meshes, lights, backgrounds, nodes and placements) is
  * mediators/sy_mirror; this adapter turns its callbacks into Embree back-end calls. */
 /* An instance's placement at each time step of a shutter of more than two steps (step 0 the open),
  * gathered over the armed syncs (sy_rti_motion, cb_instance). */
+/* An instance moved since the last path-traced render (temporal reuse's object motion): its world
+ * matrix then, and (ready) prev x now^-1, the map of this render's points to their earlier places. */
+typedef struct rt_move_rec {
+    float prev[16];
+    float to_prev[16];
+    bool ready;
+} rt_move_rec;
+
 typedef struct rt_motion_rec {
     float xf[SY_MOTION_STEPS_MAX][16];
 } rt_motion_rec;
@@ -117,6 +126,17 @@ typedef struct rt_state {
     sy_camera_view temporal_cam;
     bool temporal_have_cam;
     bool temporal_rest; /* this render's camera rests and its accumulation continues: blend (sy_rti_temporal_rest) */
+    /* object motion for temporal reuse: the device version of the last render (temporal_version);
+     * the versions move_from .. move_to that syncs published with moves only (instance transforms,
+     * visibility, deformed vertices: sync_other false), 0 .. 0 when the last change was anything else;
+     * temporal_from: per instance handle moved since the last render, its world matrix then
+     * (rt_move_rec; recorded only while filter.temporal is on); the coverage ids and motion planes */
+    uint64_t temporal_version, move_from, move_to;
+    bool sync_other;
+    sy_mirror_map temporal_from;
+    uint32_t *motion_ids;
+    float *motion_buf;
+    size_t motion_px;
     /* motion blur (SY_CAP_MOTION, sy_rti_motion): MOTION_ARMED between BEGIN and OPENED (the sync in
      * between gives each moved instance its close transform), MOTION_ON until END */
     enum { MOTION_OFF, MOTION_ARMED, MOTION_ON } motion;
@@ -140,7 +160,7 @@ typedef struct rt_state {
 /* The classes' parameter tables (sy_params.h); the counts are checked where they are defined. */
 #define SY_RTI_WHITTED_PARAM_COUNT 8
 #define SY_RTI_COVERAGE_PARAM_COUNT 5
-#define SY_RTI_PATHTRACER_PARAM_COUNT 27
+#define SY_RTI_PATHTRACER_PARAM_COUNT 28
 #ifndef SY_RTI_DEFINING_PARAMS
 extern const sy_param_decl sy_rti_whitted_params[SY_RTI_WHITTED_PARAM_COUNT];
 extern const sy_param_decl sy_rti_coverage_params[SY_RTI_COVERAGE_PARAM_COUNT];
@@ -191,10 +211,14 @@ sy_result sy_rti_filter_read_aovs(rt_state *st, const accum_slot *a, const sy_re
 sy_result sy_rti_filter_layer(rt_state *st, const sy_render_request *req, sy_layer *layer, sy_error *err);
 /* Temporal reuse after a path-traced render of `samples` samples into the slot st->last_slot: when
  * st->filter.temporal is on, the accumulation holds only this render's samples and the camera moved
- * since the previous render, writes the estimate into layer and sets *done; otherwise leaves the
+ * since the previous render, or only instances moved (sy_rti_temporal_moving; their motion given to
+ * the filter per pixel), writes the estimate into layer and sets *done; otherwise leaves the
  * layer alone (*done false). Records the camera either way. */
 sy_result sy_rti_temporal_layer(rt_state *st, const sy_render_request *req, uint32_t samples, sy_layer *layer,
                                 bool *done, sy_error *err);
+/* Whether a path-traced render of req is a moving frame for temporal reuse: the camera moved since
+ * the previous render, or only instances moved since (object motion); false while it is off. */
+bool sy_rti_temporal_moving(const rt_state *st, const sy_render_request *req);
 /* After the display filter of a render that sy_rti_temporal_layer left alone: while the camera rests
  * after moving frames, the layer (the accumulation) blended with the last temporal estimate until the
  * accumulation takes over (sy_filter_temporal_rest). */

@@ -86,6 +86,7 @@ SY_MIRROR_FLAT_TEXREF_FN(texref, sy_rt_texture_ref)
 static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_error *err)
 {
     rt_state *st = user;
+    st->sync_other = true; /* not a move (temporal reuse restarts under a still camera) */
     const sy_mirror_flat_material *m = a->flat;
     sy_rt_material_desc d;
     sy_rt_material_desc_init(&d);
@@ -112,6 +113,7 @@ static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_er
 static sy_result cb_texture(void *user, const sy_mirror_texture_args *a, sy_error *err)
 {
     rt_state *st = user;
+    st->sync_other = true;
     const sy_mirror_flat_texture *f = a->flat;
     sy_rt_texture_desc d = {f->width, f->height, f->channels, (sy_rt_texel_format)f->format, f->pixels,
                             (sy_rt_wrap)f->wrap_s, (sy_rt_wrap)f->wrap_t, f->nearest ? SY_RT_FILTER_NEAREST : SY_RT_FILTER_LINEAR};
@@ -138,6 +140,7 @@ static void rt_mesh_blobs_release(void *user)
 static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_error *err)
 {
     rt_state *st = user;
+    st->sync_other = true;
     if (st->motion == MOTION_ARMED) st->motion_other = true; /* made at the open: no pose at the close to move from */
     const sy_primitive *p = a->primitive;
     const sy_mirror_flat_mesh *f = a->flat;
@@ -181,14 +184,23 @@ static sy_result cb_instance(void *user, const sy_mirror_instance_args *a, sy_er
                                  .material = {a->material},
                                  .flags = (a->baked ? SY_RT_INSTANCE_BAKED : 0u) | (a->visible ? 0u : SY_RT_INSTANCE_HIDDEN)};
         memcpy(d.transform, a->world->m, sizeof d.transform);
+        st->sync_other = true;
         r = sy_rt_instance_create(st->dev, &d, &h);
         *a->handle = h.id;
         if (r == SY_RT_OK) inst_node_set(st, h.id, a->node, a->placement), inst_sel_set(st, h.id, a->selected);
         return r == SY_RT_OK ? SY_OK : sy_rti_fail(st, err, r, "instance");
     }
     float close[16];
-    bool moving = st->motion == MOTION_ARMED && sy_rt_instance_get_transform(st->dev, h, close) == SY_RT_OK &&
-                  memcmp(close, a->world->m, sizeof close) != 0;
+    bool had = sy_rt_instance_get_transform(st->dev, h, close) == SY_RT_OK;
+    bool moving = st->motion == MOTION_ARMED && had && memcmp(close, a->world->m, sizeof close) != 0;
+    if (had && st->filter.temporal && memcmp(close, a->world->m, sizeof close) != 0 &&
+        !sy_mirror_map_get(&st->temporal_from, h.id)) {
+        /* temporal reuse: its first move since the last render; where it was then (no memory for
+         * it: a change that is not a move, the history restarts under a still camera) */
+        rt_move_rec *mr = sy_mirror_map_put(&st->temporal_from, h.id);
+        if (mr) memcpy(mr->prev, close, sizeof close);
+        else st->sync_other = true;
+    }
     if (moving && st->motion_steps > 2u) { /* curved motion: this step's placement, applied at the open */
         rt_motion_rec *rec = sy_mirror_map_get(&st->motion_rec, h.id);
         if (!rec) { /* its first move since the close: where it was until now is every later step */
@@ -213,6 +225,7 @@ static sy_result cb_instance(void *user, const sy_mirror_instance_args *a, sy_er
 static sy_result cb_light(void *user, const sy_mirror_light_args *a, sy_error *err)
 {
     rt_state *st = user;
+    st->sync_other = true;
     if (st->motion == MOTION_ARMED) st->motion_other = true; /* a light moved over the shutter: not interpolated */
     const sy_mirror_flat_light *l = a->flat;
     sy_rt_light_desc d;
@@ -237,6 +250,7 @@ static sy_result cb_light(void *user, const sy_mirror_light_args *a, sy_error *e
 static void cb_release(void *user, const sy_mirror_release_args *a)
 {
     rt_state *st = user;
+    st->sync_other = true;
     switch (a->kind) {
     case SY_MIRROR_TEXTURE: sy_rt_texture_destroy(st->dev, (sy_rt_texture){a->handle}); break;
     case SY_MIRROR_MATERIAL: sy_rt_material_destroy(st->dev, (sy_rt_material){a->handle}); break;
@@ -245,6 +259,7 @@ static void cb_release(void *user, const sy_mirror_release_args *a)
         inst_node_set(st, a->handle, 0, 0);
         inst_sel_set(st, a->handle, false);
         sy_mirror_map_del(&st->motion_rec, a->handle); /* gone before the open: no steps to give it */
+        sy_mirror_map_del(&st->temporal_from, a->handle);
         sy_rt_instance_destroy(st->dev, (sy_rt_instance){a->handle});
         break;
     case SY_MIRROR_LIGHT: sy_rt_light_destroy(st->dev, (sy_rt_light){a->handle}); break;
@@ -349,6 +364,10 @@ sy_result sy_rti_motion_camera(void *state, const sy_camera_view *open, uint32_t
 sy_result sy_rti_sync(void *state, const sy_changes *changes, sy_error *err)
 {
     rt_state *st = state;
+    sy_rt_stats s;
+    sy_rt_device_stats(st->dev, &s);
+    uint64_t v0 = s.version;
+    st->sync_other = false;
     sy_mirror_sync_stats ms;
     sy_result r = sy_mirror_sync(st->mirror, changes, &ms, err);
     SY_MIRROR_SYNC_COUNTERS(st->counters, ms);
@@ -359,8 +378,16 @@ sy_result sy_rti_sync(void *state, const sy_changes *changes, sy_error *err)
         sy_rt_result rr = sy_rt_commit(st->dev);
         if (rr != SY_RT_OK) r = sy_rti_fail(st, err, rr, "commit");
     }
-    sy_rt_stats s;
     sy_rt_device_stats(st->dev, &s);
+    /* temporal reuse: a sync that published moves only (instance transforms or visibility, deformed
+     * vertices) extends the run of such versions, or starts one; anything else ends it */
+    if (s.version != v0) {
+        if (r != SY_OK || st->sync_other) st->move_from = st->move_to = 0;
+        else {
+            if (st->move_to != v0) st->move_from = v0;
+            st->move_to = s.version;
+        }
+    }
     st->counters.instances = s.instances;
     st->counters.meshes = s.meshes;
     st->counters.materials = s.materials;

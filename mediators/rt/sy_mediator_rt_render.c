@@ -136,11 +136,10 @@ static sy_result render_frame(rt_state *st, const sy_render_request *req, sy_lay
         if (pr != SY_OK) return pr;
         d.accum = st->slots[st->last_slot].acc;
         d.samples = req->sample_count ? req->sample_count : 1u;
-        /* temporal reuse: a moving frame (restarted accumulation, camera moved) samples with a seed
+        /* temporal reuse: a moving frame (restarted accumulation, camera or objects moved) samples with a seed
          * of its own, so that the frames' noise is independent and the history averages it (with
          * one seed the noise pattern would stay on the screen and nothing would average out) */
-        if (st->filter.temporal && st->temporal_have_cam && sy_rt_accum_samples(d.accum) == 0 &&
-            !sy_rti_same_view(&st->temporal_cam, &req->camera))
+        if (sy_rt_accum_samples(d.accum) == 0 && sy_rti_temporal_moving(st, req))
             d.seed = req->seed ^ (0x9E3779B9u * (uint32_t)(st->finfo.temporal_frames + 1));
         st->last_cam = cam, st->last_desc = d; /* the ID AOVs of this accumulation */
         if (st->filter.kind == PT_FILTER_RADIANCE) return sy_rti_radiance_render(st, req, &cam, &d, layer, err);
