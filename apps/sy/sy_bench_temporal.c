@@ -7,7 +7,8 @@
  * frame-to-frame change of the displayed luminance on pixels whose reference changes by less than
  * 1 % + 0.002) and the ratio, the change of the display when the camera stops at the path's end
  * (sy_filter_temporal_rest: no pop), and the cost of the temporal stage per frame at 640x360 next to
- * one 1-spp pass there. Ratios come from one run; nothing here is a timed test. */
+ * one 1-spp pass there, and the cost of the object motion pass (every instance sliding under a still
+ * camera) next to the rest of the stage. Ratios come from one run; nothing here is a timed test. */
 #include "sy_bench.h"
 #include "sy_interactive.h"
 #include "sy_png.h"
@@ -45,6 +46,46 @@ static void path_view(const sy_interactive_input *home, uint32_t k, sy_mat4 *m)
     sy_orbit o = home->orbit;
     sy_orbit_rotate(&o, 0.75f * (float)k, 0.0f); /* 0.006 rad per frame */
     sy_orbit_matrix(&o, m);
+}
+
+/* The nodes under root (depth first; a node shared by two parents comes twice) with a mesh and neither a light nor a camera: what
+ * the object-motion cost moves. *out malloc()ed. */
+static sy_result moving_nodes(sy_scene *scene, sy_node root, uint32_t **out, uint32_t *count, sy_error *err)
+{
+    uint32_t cap = 64, n = 0, top = 0, scap = 64;
+    uint32_t *list = malloc(cap * sizeof *list), *stack = malloc(scap * sizeof *stack);
+    sy_result r = list && stack ? SY_OK : sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench temporal: out of memory");
+    if (r == SY_OK) stack[top++] = root.id;
+    while (r == SY_OK && top) {
+        uint32_t id = stack[--top];
+        const sy_node_data *d = sy_node_get(scene, (sy_node){id});
+        if (!d) continue;
+        if (d->mesh.id && !d->light.id && !d->camera.id) {
+            if (n == cap) {
+                uint32_t *g = realloc(list, 2 * cap * sizeof *list);
+                if (!g) { r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench temporal: out of memory"); break; }
+                list = g, cap *= 2;
+            }
+            list[n++] = id;
+        }
+        uint32_t nc = 0;
+        const uint32_t *c = sy_node_children(d, &nc);
+        for (uint32_t i = 0; i < nc && r == SY_OK; ++i) {
+            if (top == scap) {
+                uint32_t *g = realloc(stack, 2 * scap * sizeof *stack);
+                if (!g) { r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench temporal: out of memory"); break; }
+                stack = g, scap *= 2;
+            }
+            stack[top++] = c[i];
+        }
+    }
+    free(stack);
+    if (r != SY_OK) {
+        free(list);
+        list = NULL, n = 0;
+    }
+    *out = list, *count = n;
+    return r;
 }
 
 typedef struct bench_win {
@@ -226,6 +267,49 @@ sy_result sy_bench_temporal(sy_scene *scene, const sy_viewport_desc *vd, const c
                "reused history on %.0f %% of the hits\n",
                tt[6] * 1e3, tf[6] * 1e3, tt[6] / tf[6], tc[6] * 1e3, 100.0 * fi.temporal_reused);
     }
+    /* object motion at 640x360: the camera still at the path's start, every node under the viewport's
+     * root with a mesh (and no light or camera: a moved light is not a move) sliding sideways by 0.2 % of the orbit distance per frame (every instance moves), 12
+     * frames: the object motion pass (coverage rays + per-pixel motion) against the rest of the
+     * temporal stage (AOV read, reprojection, a-trous) */
+    uint32_t nkids = 0;
+    uint32_t *kids = NULL;
+    if (r == SY_OK) r = moving_nodes(scene, vd->root, &kids, &nkids, err);
+    sy_mat4 *saved = nkids ? malloc(nkids * sizeof *saved) : NULL;
+    if (r == SY_OK && nkids && !saved) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench temporal: out of memory");
+    for (uint32_t i = 0; saved && i < nkids; ++i) saved[i] = sy_node_get(scene, (sy_node){kids[i]})->transform.matrix;
+    double om[12], os[12];
+    uint64_t moving = 0;
+    for (uint32_t k = 0; k < 13 && r == SY_OK && saved; ++k) {
+        for (uint32_t i = 0; i < nkids && r == SY_OK; ++i) {
+            sy_mat4 m = saved[i];
+            m.m[12] += 0.002f * home.orbit.dist * (float)k;
+            r = sy_node_set_matrix(scene, (sy_node){kids[i]}, &m, err);
+        }
+        if (r == SY_OK) r = sy_scene_commit(scene, NULL, err);
+        sy_mat4 m;
+        path_view(&home, 0, &m);
+        double s;
+        if (r == SY_OK) r = bench_win_frame(&cost, &m, scene, pool, 1, 0, &a, &s, err);
+        if (r == SY_OK && k > 0) {
+            sy_mediator_rt_filter_info_get(sy_context_state(ctx), &fi);
+            om[k - 1] = fi.temporal_motion_seconds, os[k - 1] = fi.temporal_seconds - fi.temporal_motion_seconds;
+            moving = fi.temporal_moving_pixels;
+        }
+    }
+    if (saved) { /* the scene as it was */
+        for (uint32_t i = 0; i < nkids; ++i) (void)sy_node_set_matrix(scene, (sy_node){kids[i]}, &saved[i], NULL);
+        (void)sy_scene_commit(scene, NULL, NULL);
+        if (r == SY_OK) {
+            qsort(om, 12, sizeof om[0], sy_bench_cmp_double);
+            qsort(os, 12, sizeof os[0], sy_bench_cmp_double);
+            printf("  object motion at 640x360 (still camera, every instance sliding): motion pass %.2f ms per frame "
+                   "(median of 12; coverage rays + per-pixel motion), the rest of the temporal stage %.1f ms: %.2fx; "
+                   "%llu moving pixels\n",
+                   om[6] * 1e3, os[6] * 1e3, om[6] / os[6], (unsigned long long)moving);
+        }
+        free(saved);
+    }
+    free(kids);
     for (int q = 0; q <= SERIES; ++q) free(prev[q]), sy_layer_destroy(&img[q]);
     sy_layer_destroy(&a);
     sy_context_pool_destroy(pool);
