@@ -19,7 +19,9 @@
  *   - the frames with the motion show the estimate (temporal_last) with moving pixels counted;
  *     without it the still camera's frames are the plain accumulation.
  * Then the camera and the ball rest: the accumulation continues, blended with the estimate, and
- * from 64 samples on is the plain accumulation bit for bit (a converged still is never changed).
+ * from 64 samples on is the plain accumulation bit for bit (a converged still is never changed); a
+ * material change under it restarts the accumulation, shown alone (no estimate), and a move after
+ * that is a moving frame again.
  * Prints the numbers per frame. */
 #include "it_util.h"
 #include "sy_mediator_rt.h"
@@ -33,6 +35,7 @@
 typedef struct fixture {
     sy_scene *s;
     sy_node root, wall, ball, cam_node;
+    sy_material light_grey;
     sy_viewport *vp;
     sy_window *win;
     sy_context_pool *pool[3]; /* 0: motion, 1: camera only, 2: reference */
@@ -109,6 +112,7 @@ static void build(fixture *fx)
     sy_scene *s = fx->s;
     MUST(sy_node_create(s, "root", &fx->root, err));
     sy_material grey[2] = {lambert(s, "light grey", 0.8f, 0.8f, 0.8f), lambert(s, "dark grey", 0.3f, 0.3f, 0.3f)};
+    fx->light_grey = grey[0];
     sy_material rg[2] = {lambert(s, "red", 0.9f, 0.15f, 0.1f), lambert(s, "green", 0.1f, 0.8f, 0.2f)};
     float wq[8][3];
     sy_material wm[8];
@@ -268,6 +272,27 @@ int main(void)
         sy_mediator_rt_filter_info_get(sy_context_state(ctx), &fi);
         EXPECT_MSG(!fi.temporal_last && same == (k >= 64), "still frame %u: estimate %d, the accumulation %d", k,
                    fi.temporal_last, same);
+    }
+    /* a change that is not a move (a material) under the still camera: the accumulation restarts and
+     * shows alone, as before; a move after it is a moving frame again */
+    sy_material_data md = *sy_material_get(fx.s, fx.light_grey);
+    md.name = "light grey";
+    md.base_color[0] = 0.7f;
+    MUST(sy_material_set(fx.s, fx.light_grey, &md, err));
+    for (int step = 0; step < 2; ++step) {
+        if (step) place_ball(&fx, 3);
+        MUST(sy_scene_commit(fx.s, NULL, err));
+        render(&fx, 0, 1);
+        sy_mediator_rt_aovs a;
+        MUST(sy_mediator_rt_aovs_get(sy_context_state(ctx), &a, err));
+        bool same = !memcmp(a.planes[0], fx.img[0].rgba, (size_t)W * H * 4 * sizeof(float));
+        EXPECT_MSG(a.samples == 1, "after the %s: %u samples", step ? "move" : "material change", a.samples);
+        sy_mediator_rt_aovs_free(&a);
+        sy_mediator_rt_filter_info fi;
+        sy_mediator_rt_filter_info_get(sy_context_state(ctx), &fi);
+        EXPECT_MSG(fi.temporal_last == (step == 1) && same == (step == 0),
+                   "after the %s: estimate %d, the accumulation %d", step ? "move" : "material change", fi.temporal_last,
+                   same);
     }
     destroy(&fx);
     return sy_check_finish("integration_pathtracer_motion");
