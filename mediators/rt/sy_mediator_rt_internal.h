@@ -121,7 +121,8 @@ typedef struct rt_state {
     size_t fbuf_px;                /* pixels the fbuf planes hold */
     sy_mediator_rt_filter_info finfo; /* last filtered frame */
     /* temporal reuse (filter.temporal): one history per context, fed by every path-traced render
-     * whose camera differs from the previous render's (temporal_cam) */
+     * whose camera differs from the previous render's (temporal_cam), or (filter.temporal_motion)
+     * whose scene changed since only by moves (sy_rti_temporal_moving) */
     sy_filter_temporal *temporal;
     sy_camera_view temporal_cam;
     bool temporal_have_cam;
