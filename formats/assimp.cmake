@@ -4,6 +4,7 @@
 pkg_check_modules(SY_ASSIMP REQUIRED IMPORTED_TARGET assimp)
 target_sources(sy_formats PRIVATE
   sy_assimp.c
+  sy_assimp_anim.c
   sy_assimp_io.c
   sy_assimp_isolate.c
   sy_assimp_materials.c

@@ -165,18 +165,18 @@ static sy_result convert(asp_loader *L)
     if (!(L->materials = calloc((size_t)s->mNumMaterials + 1, sizeof *L->materials)) ||
         !(L->normal_mapped = calloc((size_t)s->mNumMaterials + 1, sizeof *L->normal_mapped)) ||
         !(L->meshes = calloc((size_t)s->mNumMeshes + 1, sizeof *L->meshes)) ||
-        !(L->mesh_bounds = calloc((size_t)s->mNumMeshes + 1, sizeof *L->mesh_bounds)))
+        !(L->mesh_bounds = calloc((size_t)s->mNumMeshes + 1, sizeof *L->mesh_bounds)) ||
+        !(L->mesh_skinned = calloc((size_t)s->mNumMeshes + 1, sizeof *L->mesh_skinned)) ||
+        !(L->mesh_targets = calloc((size_t)s->mNumMeshes + 1, sizeof *L->mesh_targets)))
         return asp_fail(L, SY_ERR_OUT_OF_MEMORY, "out of memory for %u meshes and %u materials", s->mNumMeshes, s->mNumMaterials);
     /* dependency order: textures (on demand) + materials, meshes, then nodes, cameras, lights */
     for (unsigned i = 0; i < s->mNumMaterials && r == SY_OK; ++i) r = asp_create_material(L, i);
     if (r == SY_OK) r = asp_charge(L);
     for (unsigned i = 0; i < s->mNumMeshes && r == SY_OK; ++i) r = asp_create_mesh(L, i);
     if (r == SY_OK) r = asp_create_nodes(L);
-    if (r == SY_OK && (c->animations || c->skinned_meshes || c->morph_targets))
-        asp_note(L, SY_LOG_NOTE,
-               "%u animations, %u skinned meshes (%u bones), %u morph targets: not played yet (meshes in their bind "
-               "pose)",
-               c->animations, c->skinned_meshes, c->bones, c->morph_targets);
+    /* then what needs the nodes by name: skins (joints), clips (channel targets) */
+    if (r == SY_OK) r = asp_create_skins(L);
+    if (r == SY_OK) r = asp_create_animations(L);
     return r;
 }
 
@@ -226,6 +226,10 @@ out:
     free(L.normal_mapped);
     free(L.meshes);
     free(L.mesh_bounds);
+    free(L.mesh_skinned);
+    free(L.mesh_targets);
+    free(L.named);
+    free(L.placements);
     free(L.objs);
     free(L.main_name);
     for (size_t k = 0; k < L.mtl_dir_count; ++k) free(L.mtl_dirs[k]);

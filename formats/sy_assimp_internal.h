@@ -7,6 +7,8 @@
  *                          integer lists)
  *   sy_assimp_materials.c  textures (files and embedded) and materials
  *   sy_assimp_scene.c      meshes, cameras, lights, the node tree, units and up axis
+ *   sy_assimp_anim.c       bones (skin attributes and node skins), anim meshes (morph targets) and
+ *                          animations (clips with node TRS and morph weight channels)
  *   sy_assimp.c            options, the import, the conversion in order (the load in one process)
  *   sy_assimp_isolate.c    the public entry points (sy_assimp.h): the load in a child process (the
  *                          import process) whose scene changes come back as a change list
@@ -50,6 +52,21 @@ typedef struct asp_notes {
     uint32_t dropped;
 } asp_notes;
 
+/* A node of the file's tree by name (the tree's nodes sorted by name, then by breadth-first order). */
+typedef struct asp_named {
+    const struct aiNode *ai;
+    sy_node node;
+    uint32_t walk; /* its breadth-first index */
+    bool trs;      /* its transform was turned into TRS for an animation channel */
+} asp_named;
+
+/* A node that draws a mesh: the tree node itself (one mesh) or a child made for each of its meshes. */
+typedef struct asp_placement {
+    uint32_t walk; /* the tree node's breadth-first index */
+    unsigned mesh; /* the aiMesh */
+    sy_node node;  /* the node holding the mesh */
+} asp_placement;
+
 typedef struct asp_loader {
     const char *path;      /* names the file in messages */
     char *model_dir;       /* the model's folder ("" = the working directory), '/'-terminated or "" */
@@ -65,6 +82,13 @@ typedef struct asp_loader {
     bool *normal_mapped;         /* per aiMaterial: has a normal texture */
     sy_mesh *meshes;             /* per aiMesh; {0}: skipped */
     sy_bounds *mesh_bounds;      /* per aiMesh: its positions' bounds */
+    bool *mesh_skinned;          /* per aiMesh: its primitive has joints and weights */
+    uint32_t *mesh_targets;      /* per aiMesh: morph targets its primitive has */
+    asp_named *named;            /* the tree's nodes by name (asp_create_nodes) */
+    size_t named_count;
+    asp_placement *placements;   /* every node that draws a mesh, in creation order */
+    size_t placement_count, placement_cap;
+    bool anim_states_warned;     /* a channel's pre / post state the clock cannot follow: warned once */
     asp_texture *textures;
     size_t texture_count, texture_cap;
     /* the confined file system */
@@ -124,6 +148,20 @@ sy_result asp_charge(asp_loader *L);
 sy_result asp_create_mesh(asp_loader *L, unsigned i);
 /* The node tree under a new root (units and up axis), cameras and lights. */
 sy_result asp_create_nodes(asp_loader *L);
+
+/* >>anim (sy_assimp_anim.c) ------------------------------------------------------------------- */
+
+/* Mesh i's bones (joints and weights, at most SY_SKIN_MAX_INFLUENCES per vertex: the largest kept,
+ * renormalised) and anim meshes (morph target deltas: Assimp's absolute positions and normals minus
+ * the mesh's) into p; the budget charged first. What cannot be used is dropped with a warning. */
+sy_result asp_mesh_deform(asp_loader *L, unsigned i, const struct aiMesh *m, sy_primitive *p);
+/* Mesh i's default morph weights (the anim meshes' mWeight) once the mesh exists. */
+sy_result asp_mesh_weights(asp_loader *L, unsigned i);
+/* The node named `name` (the first in breadth-first order), NULL when none. */
+asp_named *asp_find_named(asp_loader *L, const char *name);
+/* Skins on every node that draws a skinned mesh, and the file's animations as clips (after the nodes). */
+sy_result asp_create_skins(asp_loader *L);
+sy_result asp_create_animations(asp_loader *L);
 
 /* >>load (sy_assimp.c) ------------------------------------------------------------------------- */
 

@@ -155,6 +155,7 @@ static sy_result make_primitive(asp_loader *L, unsigned i, const struct aiMesh *
     for (unsigned c = 1; c < AI_MAX_NUMBER_OF_COLOR_SETS; ++c) extra += m->mColors[c] != NULL;
     if (extra) asp_warn(L, "%s: %u more texture coordinate or colour sets not kept (two and one are)", where, extra);
     p->topology = per == 3 ? SY_TOPOLOGY_TRIANGLES : per == 2 ? SY_TOPOLOGY_LINES : SY_TOPOLOGY_POINTS;
+    if ((r = asp_mesh_deform(L, i, m, p))) return r;
     unsigned mi = m->mMaterialIndex < L->ai->mNumMaterials ? m->mMaterialIndex : 0;
     p->material = L->ai->mNumMaterials ? L->materials[mi] : (sy_material){0};
     if (per == 3 && L->ai->mNumMaterials && L->normal_mapped[mi] && p->normals) {
@@ -199,12 +200,15 @@ sy_result asp_create_mesh(asp_loader *L, unsigned i)
     if (r == SY_OK) {
         L->meshes[i] = (sy_mesh){id};
         L->mesh_bounds[i] = sy_primitive_position_bounds(&p);
+        L->mesh_skinned[i] = p.joints != NULL;
+        L->mesh_targets[i] = sy_primitive_target_count(&p);
         c->meshes++;
         if (per == 3) c->triangles += elements;
         else if (per == 2) c->line_segments += elements;
         else c->points += elements;
     }
     sy_primitive_release(&p);
+    if (r == SY_OK && L->mesh_targets[i]) r = asp_mesh_weights(L, i);
     return r;
 }
 
@@ -279,6 +283,24 @@ static int by_name(const void *a, const void *b)
 {
     const walk_node *x = *(walk_node *const *)a, *y = *(walk_node *const *)b;
     return strcmp(asp_str(&x->ai->mName), asp_str(&y->ai->mName));
+}
+
+static int named_order(const void *a, const void *b)
+{
+    const asp_named *x = a, *y = b;
+    int c = strcmp(asp_str(&x->ai->mName), asp_str(&y->ai->mName));
+    return c ? c : x->walk < y->walk ? -1 : x->walk > y->walk;
+}
+
+asp_named *asp_find_named(asp_loader *L, const char *name)
+{
+    size_t lo = 0, hi = L->named_count;
+    while (lo < hi) {
+        size_t mid = (lo + hi) / 2;
+        if (strcmp(asp_str(&L->named[mid].ai->mName), name) < 0) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo < L->named_count && !strcmp(asp_str(&L->named[lo].ai->mName), name) ? &L->named[lo] : NULL;
 }
 
 /* The node named `name` (the first in breadth-first order), NULL when none. */
@@ -551,8 +573,13 @@ sy_result asp_create_nodes(asp_loader *L)
             if (mi >= s->mNumMeshes || !L->meshes[mi].id) continue;
             sy_bounds b = sy_bounds_transform(&L->mesh_bounds[mi], &x->world);
             sy_bounds_add_bounds(&bounds, &b);
+            if (!sy_array_reserve(&L->placements, L->placement_count, &L->placement_cap, sizeof *L->placements, 16)) {
+                r = asp_fail(L, SY_ERR_OUT_OF_MEMORY, "out of memory for nodes");
+                break;
+            }
             if (x->ai->mNumMeshes == 1) {
                 if ((r = sy_node_set_mesh(L->scene, x->node, L->meshes[mi], &L->err))) sy_error_prefix(&L->err, "%s: %s", L->path, what);
+                else L->placements[L->placement_count++] = (asp_placement){(uint32_t)k, mi, x->node};
                 continue;
             }
             uint32_t cid;
@@ -561,10 +588,19 @@ sy_result asp_create_nodes(asp_loader *L)
                 (r = sy_node_set_flags(L->scene, (sy_node){cid}, SY_NODE_VISIBLE, &L->err)) ||
                 (r = push_extra(L, &ex, &nex, &cap_ex, (uint32_t)k, (sy_node){cid})))
                 break;
+            L->placements[L->placement_count++] = (asp_placement){(uint32_t)k, mi, (sy_node){cid}};
         }
         sorted[k] = x;
     }
     if (r) goto done;
+    /* the tree by name, for bones and animation channels (sy_assimp_anim.c) */
+    if (!(L->named = calloc(tail + 1, sizeof *L->named))) {
+        r = asp_fail(L, SY_ERR_OUT_OF_MEMORY, "out of memory for %zu nodes", tail);
+        goto done;
+    }
+    for (size_t k = 0; k < tail; ++k) L->named[k] = (asp_named){w[k].ai, w[k].node, (uint32_t)k, false};
+    L->named_count = tail;
+    qsort(L->named, tail, sizeof *L->named, named_order);
     qsort(sorted, tail, sizeof *sorted, by_name);
     for (unsigned i = 0; i < s->mNumCameras + s->mNumLights && r == SY_OK; ++i) {
         bool cam = i < s->mNumCameras;
