@@ -111,16 +111,16 @@ int sy_cmd_info(int argc, char **argv)
     cJSON *doc = cJSON_CreateObject();
     sy_json_add(doc, "file", sy_json_str(path));
     sy_json_add(doc, "format", sy_json_str(ld.is_gltf ? "gltf" : ld.is_x3d ? "x3d" : ld.is_assimp ? "assimp" : "demo"));
-    if (ld.is_assimp) { /* which of Assimp's importers, and what the core does not hold yet */
+    if (ld.is_assimp) { /* which of Assimp's importers; its skins and morph targets (the clips are listed below) */
         const sy_assimp_info *ai = &ld.assimp;
         const sy_assimp_counts *ac = &ai->counts;
         sy_json_add(doc, "importer", sy_json_str(ai->format));
         sy_json_add(doc, "unit_scale", sy_json_float((double)ai->unit_scale));
         sy_json_add(doc, "up_axis", ai->up_axis < 0 ? cJSON_CreateNull() : sy_json_str(ai->up_axis == 0 ? "x" : ai->up_axis == 1 ? "y" : "z"));
-        static const char *const an[] = {"animations", "skinned_meshes", "bones", "morph_targets", "embedded_textures"};
-        const uint32_t av[] = {ac->animations, ac->skinned_meshes, ac->bones, ac->morph_targets, ac->embedded_textures};
-        jcounts(sy_json_add(doc, "not_loaded", cJSON_CreateObject()), an, av, 4);
-        sy_json_add(doc, "embedded_textures", cJSON_CreateNumber(av[4]));
+        static const char *const an[] = {"skinned_meshes", "bones", "morph_targets"};
+        const uint32_t av[] = {ac->skinned_meshes, ac->bones, ac->morph_targets};
+        jcounts(sy_json_add(doc, "skins_and_morphs", cJSON_CreateObject()), an, av, 3);
+        sy_json_add(doc, "embedded_textures", cJSON_CreateNumber(ac->embedded_textures));
     }
     static const char *const names[] = {"nodes",  "meshes", "primitives", "triangles", "materials",     "textures",
                                         "images", "lights", "cameras",    "points",    "line_segments", "skipped",

@@ -10,7 +10,12 @@
  * Every error names the file. Also: an MTL in a subfolder naming its texture relative to itself
  * (found; one leading out of the model's folder refused), separate metalness / roughness maps
  * combined into one metallic-roughness texture (same size, resampled, one map, a missing map), a
- * valid triangle under Assimp's default degenerate-area threshold (kept). */
+ * valid triangle under Assimp's default degenerate-area threshold (kept). Animations (issue 35): a
+ * DirectX .x file with three clips, one whose position keys go back in time, one with a key beyond
+ * the coordinate range, one channel naming no node: each dropped with a warning naming the
+ * animation, the channel and the key, the file still loads, and the good channel plays (the node's
+ * matrix turned into TRS; 25 ticks per second). */
+#include "sy_anim.h"
 #include "sy_assimp.h"
 #include "sy_classic.h"
 #include "sy_scene.h"
@@ -360,6 +365,48 @@ int main(void)
     EXPECT(put_file(dir, "small.obj", small, sizeof small - 1, p, sizeof p) == 0);
     EXPECT_MSG(load(p, NULL, &info, &e) == SY_OK && info.counts.triangles == 2 && info.warning_count == 0,
                "small.obj: %u triangles: %s", info.counts.triangles, info.warning_count ? info.warnings[0] : e.message);
+    sy_assimp_info_free(&info);
+
+    /* animations with bad keys: warned and dropped, the rest plays */
+    const char anim_x[] =
+        "xof 0302txt 0064\n"
+        "Frame Root {\n FrameTransformMatrix { 1.0,0.0,0.0,0.0, 0.0,1.0,0.0,0.0, 0.0,0.0,1.0,0.0, 0.0,0.5,0.0,1.0;; }\n"
+        " Mesh { 3; 0.0;0.0;0.0;, 1.0;0.0;0.0;, 0.0;1.0;0.0;; 1; 3;0,1,2;; }\n}\n"
+        "AnimationSet Back {\n Animation {\n  {Root}\n"
+        "  AnimationKey { 2; 4; 0;3;0.0,0.0,0.0;;, 10;3;1.0,0.0,0.0;;, 5;3;2.0,0.0,0.0;;, 20;3;2.0,0.0,0.0;;; }\n }\n}\n"
+        "AnimationSet Huge {\n Animation {\n  {Root}\n"
+        "  AnimationKey { 2; 2; 0;3;0.0,0.0,0.0;;, 10;3;1e30,0.0,0.0;;; }\n }\n}\n"
+        "AnimationSet Good {\n Animation {\n  {Root}\n"
+        "  AnimationKey { 2; 2; 0;3;0.0,0.0,0.0;;, 10;3;4.0,0.0,0.0;;; }\n }\n"
+        " Animation {\n  {Nowhere}\n  AnimationKey { 2; 2; 0;3;0.0,0.0,0.0;;, 10;3;1.0,0.0,0.0;;; }\n }\n}\n";
+    EXPECT(put_file(dir, "anim.x", anim_x, sizeof anim_x - 1, p, sizeof p) == 0);
+    EXPECT_MSG(load(p, NULL, &info, &e) == SY_OK, "anim.x: %s", e.message);
+    EXPECT_MSG(sy_scene_count(g_scene, SY_TYPE_ANIMATION) == 3, "anim.x: %u clips", sy_scene_count(g_scene, SY_TYPE_ANIMATION));
+    static const char *const anim_says[] = {"animations[0].channels[0] 'Root': position key 2 time (0.2 s) is not after the one before",
+                                            "animations[1].channels[0] 'Root': position key 1 value is not finite or beyond the coordinate range",
+                                            "animations[2].channels[1]: node 'Nowhere' is not in the tree"};
+    for (size_t k = 0; k < 3; ++k) {
+        bool found = false;
+        for (uint32_t w = 0; w < info.stored_warning_count; ++w) found = found || strstr(info.warnings[w], anim_says[k]);
+        EXPECT_MSG(found, "anim.x: no warning '%s' (%u warnings%s%s)", anim_says[k], info.warning_count,
+                   info.stored_warning_count ? ", the first: " : "", info.stored_warning_count ? info.warnings[0] : "");
+    }
+    sy_animation good_clip = {0};
+    sy_node root_node = {0};
+    EXPECT_MSG(sy_animation_find(g_scene, "Good", &good_clip, &e) == SY_OK, "anim.x: %s", e.message);
+    for (uint32_t id = sy_scene_next(g_scene, SY_TYPE_NODE, 0); id; id = sy_scene_next(g_scene, SY_TYPE_NODE, id)) {
+        const sy_node_data *nd = sy_node_get(g_scene, (sy_node){id});
+        if (nd && nd->name && !strcmp(nd->name, "Root")) root_node = (sy_node){id};
+    }
+    double t0 = -1, t1 = -1;
+    EXPECT(sy_scene_time_range(g_scene, good_clip, &t0, &t1, &e) == SY_OK && near((float)t1, 0.4f)); /* 10 ticks at 25 per second */
+    EXPECT_MSG(root_node.id && sy_scene_set_time(g_scene, good_clip, 0.2, &e) == SY_OK, "anim.x: set time: %s", e.message);
+    const sy_node_data *rn = root_node.id ? sy_node_get(g_scene, root_node) : NULL;
+    EXPECT_MSG(rn && rn->transform.mode == SY_TRANSFORM_TRS && near(rn->transform.translation[0], 2.0f) && near(rn->transform.translation[1], 0.0f) &&
+                   near(rn->transform.scale[0], 1.0f) && near(rn->transform.rotation[3], 1.0f),
+               "anim.x: Root at t=0.2: mode %d, translation %g %g %g (want TRS, 2 0 0)", rn ? (int)rn->transform.mode : -1,
+               rn ? rn->transform.translation[0] : -1, rn ? rn->transform.translation[1] : -1,
+               rn ? rn->transform.translation[2] : -1);
     sy_assimp_info_free(&info);
 
     /* a file Assimp cannot read: Assimp's reason and the file name */
