@@ -59,8 +59,15 @@
  * "FrontAxis", "CoordAxis" with their signs) the root node scales to metres and turns the file's
  * up axis to +Y, front to +Z and right to +X. COLLADA's unit and up axis are applied by Assimp
  * itself. Formats without such metadata (OBJ, STL, PLY, 3MF, 3DS) are taken as they are.
- * Skins, morph targets and animations: the core has no objects for them yet; they are counted
- * (sy_assimp_counts), meshes are shown in their bind pose, and a note names the counts.
+ * Skins, morph targets and animations (sy_assimp_anim.c; docs/FORMATS.md "Assimp formats"): the
+ * same core objects as glTF's. Bones become joint indices and weights (at most 8 per vertex, the
+ * largest, renormalised) and a skin on each node drawing the mesh (joints: the nodes named by the
+ * bones; inverse bind: mOffsetMatrix); anim meshes become morph target deltas (Assimp's absolute
+ * positions and normals minus the mesh's), their mWeight the default weights; each aiAnimation one
+ * clip (times: ticks / mTicksPerSecond, 25 when 0) with LINEAR translation / rotation / scale
+ * channels on the nodes named by its node channels (their matrices turned into TRS) and weights
+ * channels for its morph channels; outside its keys a channel holds its end keys (LINEAR and
+ * REPEAT pre / post states too, warned). Bad keys drop their channel with a warning.
  *
  * The import process: Assimp 5.2 crashes, aborts or loops on some malformed files (its fuzzers
  * keep finding such bugs), which no check before it can foresee. So each load runs in a child
@@ -136,7 +143,7 @@ typedef struct sy_assimp_counts {
     /** @{ elements of point and line meshes */
     uint32_t points, line_segments; /** @} */
     uint32_t skipped;    /**< meshes, lights and texture slots skipped (each also a warning) */
-    /** @{ not in the core yet: counted only */
+    /** @{ animations (clips), meshes with bones, their bones, morph targets (anim meshes), as the file has them */
     uint32_t animations, skinned_meshes, bones, morph_targets; /** @} */
 } sy_assimp_counts;
 
