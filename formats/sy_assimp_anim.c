@@ -96,7 +96,7 @@ static sy_result mesh_bones(asp_loader *L, const char *where, const struct aiMes
     if (bad_id) asp_warn(L, "%s: %zu bone weights name a vertex past the %zu vertices; ignored", where, bad_id, nv);
     if (bad_w) asp_warn(L, "%s: %zu bone weights not finite and >= 0; ignored", where, bad_w);
     if (over)
-        asp_warn(L, "%s: vertices with more than %u bone weights (%zu more); the %u largest kept, renormalised", where, K, over, K);
+        asp_warn(L, "%s: vertices with more than %u bone weights (%zu weights dropped); the %u largest kept, renormalised", where, K, over, K);
     uint32_t inf = most <= 4 ? 4 : K;
     if (most == 0) {
         asp_warn(L, "%s: %u bones but no usable weight; not skinned", where, m->mNumBones);

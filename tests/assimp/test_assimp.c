@@ -14,7 +14,8 @@
  * DirectX .x file with three clips, one whose position keys go back in time, one with a key beyond
  * the coordinate range, one channel naming no node: each dropped with a warning naming the
  * animation, the channel and the key, the file still loads, and the good channel plays (the node's
- * matrix turned into TRS; 25 ticks per second). */
+ * matrix turned into TRS; 25 ticks per second). Skins: a .x mesh whose vertex has 10 bone weights keeps
+ * the 8 largest, renormalised, with a warning; its node's skin has the 10 bones' nodes as joints. */
 #include "sy_anim.h"
 #include "sy_assimp.h"
 #include "sy_classic.h"
@@ -408,6 +409,53 @@ int main(void)
                rn ? rn->transform.translation[0] : -1, rn ? rn->transform.translation[1] : -1,
                rn ? rn->transform.translation[2] : -1);
     sy_assimp_info_free(&info);
+
+    /* a skin with more than 8 weights on a vertex: the 8 largest kept, renormalised, warned once;
+     * vertex 0 weighs 0.1 .. 1.0 on bones b0 .. b9, vertex 1 1.0 on each, vertex 2 none */
+    {
+        static const char ident[] = "1.0,0.0,0.0,0.0,0.0,1.0,0.0,0.0,0.0,0.0,1.0,0.0,0.0,0.0,0.0,1.0";
+        char skin_x[8192];
+        int n = snprintf(skin_x, sizeof skin_x,
+                         "xof 0302txt 0064\nFrame Root {\n FrameTransformMatrix { %s;; }\n Mesh { 3; 0.0;0.0;0.0;, 1.0;0.0;0.0;, "
+                         "0.0;1.0;0.0;; 1; 3;0,1,2;;\n  XSkinMeshHeader { 10; 10; 10; }\n", ident);
+        for (int k = 0; k < 10; ++k)
+            n += snprintf(skin_x + n, sizeof skin_x - (size_t)n, "  SkinWeights { \"b%d\"; 2; 0,1; %.1f,1.0; %s;; }\n", k,
+                          0.1 * (k + 1), ident);
+        n += snprintf(skin_x + n, sizeof skin_x - (size_t)n, " }\n");
+        for (int k = 0; k < 10; ++k)
+            n += snprintf(skin_x + n, sizeof skin_x - (size_t)n, " Frame b%d { FrameTransformMatrix { %s;; } }\n", k, ident);
+        n += snprintf(skin_x + n, sizeof skin_x - (size_t)n, "}\n");
+        EXPECT(put_file(dir, "skin.x", skin_x, (size_t)n, p, sizeof p) == 0);
+        EXPECT_MSG(load(p, NULL, &info, &e) == SY_OK, "skin.x: %s", e.message);
+        EXPECT_MSG(info.stored_warning_count >= 1 && strstr(info.warnings[0], "more than 8 bone weights") &&
+                       strstr(info.warnings[0], "8 largest kept"),
+                   "skin.x: %s", info.stored_warning_count ? info.warnings[0] : "no warning");
+        const sy_mesh_data *sm = first_mesh();
+        const sy_primitive *pr = sm && sm->primitives.count == 1 ? &sm->primitives.items[0] : NULL;
+        EXPECT_MSG(pr && sy_primitive_influences(pr) == 8, "skin.x: %u influences per vertex", pr ? sy_primitive_influences(pr) : 0);
+        if (pr && sy_primitive_influences(pr) == 8) {
+            const uint32_t *jt = sy_blob_data(pr->joints);
+            const float *wt = sy_blob_data(pr->weights);
+            float sum0 = 0, sum1 = 0, min0 = 1;
+            unsigned seen0 = 0;
+            for (int k = 0; k < 8; ++k) {
+                sum0 += wt[k], sum1 += wt[8 + k], min0 = fminf(min0, wt[k]);
+                seen0 |= 1u << (jt[k] < 10 ? jt[k] : 31);
+                EXPECT_MSG(near(wt[8 + k], 0.125f) && wt[16 + k] == 0.0f, "skin.x: vertex 1 / 2 weight %d: %g %g", k,
+                           wt[8 + k], wt[16 + k]);
+            }
+            EXPECT_MSG(near(sum0, 1.0f) && near(sum1, 1.0f) && near(min0, 0.3f / 5.2f) && seen0 == 0x3fcu,
+                       "skin.x: vertex 0: sum %g, smallest %g (want 0.3 / 5.2), bones %#x (want b2 .. b9)", sum0, min0, seen0);
+        }
+        uint32_t nj = 0;
+        for (uint32_t id = sy_scene_next(g_scene, SY_TYPE_NODE, 0); id; id = sy_scene_next(g_scene, SY_TYPE_NODE, id)) {
+            const sy_node_data *nd = sy_node_get(g_scene, (sy_node){id});
+            uint32_t c = 0;
+            if (nd && nd->mesh.id && sy_node_skin(nd, &c) && c) nj = c;
+        }
+        EXPECT_MSG(nj == 10, "skin.x: the mesh's node has a skin of %u joints (want 10)", nj);
+        sy_assimp_info_free(&info);
+    }
 
     /* a file Assimp cannot read: Assimp's reason and the file name */
     const char junk[] = "this is not a 3DS file at all, only some text";
