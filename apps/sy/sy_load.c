@@ -413,7 +413,7 @@ sy_result sy_cli_load(const char *path, const char *camera_sel, bool defaults, l
 sy_animation sy_cli_default_clip(const loaded *ld)
 {
     sy_animation every = {0}, first = {sy_scene_next(ld->scene, SY_TYPE_ANIMATION, 0)};
-    if (!ld->is_gltf || sy_scene_count(ld->scene, SY_TYPE_ANIMATION) < 2) return every;
+    if (!(ld->is_gltf || ld->is_assimp) || sy_scene_count(ld->scene, SY_TYPE_ANIMATION) < 2) return every;
     size_t n = 0, cap = 0;
     sy_u32_pair *ct = NULL; /* (target, clip) pairs, by target: two clips drive one object when one target has two */
     for (uint32_t id = first.id; id; id = sy_scene_next(ld->scene, SY_TYPE_ANIMATION, id)) {

@@ -89,10 +89,10 @@ sy_result sy_cli_find_nodes(const sy_scene *s, const char *opt, const char *node
 sy_result sy_cli_load(const char *path, const char *camera_sel, bool defaults, loaded *out, sy_error *err);
 void sy_cli_loaded_free(loaded *l);
 /* The clip a scene plays when no --clip is given ({0}: every animation, sy_scene_set_time): a
- * glTF file whose animations drive the same objects holds alternatives (a character's walk, run
- * and idle on the same joints: the Fox), so its first one plays, as Blender's importer makes it
- * active; animations on separate objects (InterpolationTest's cubes) all play. An X3D file's
- * TimeSensors all run at once, as X3D says, and so do the clips of other formats. */
+ * glTF file (or one read through Assimp: an FBX file's takes) whose animations drive the same
+ * objects holds alternatives (a character's walk, run and idle on the same joints: the Fox), so its
+ * first one plays, as Blender's importer makes it active; animations on separate objects
+ * (InterpolationTest's cubes) all play. An X3D file's TimeSensors all run at once, as X3D says. */
 sy_animation sy_cli_default_clip(const loaded *ld);
 /* --at SECONDS / --clip NAME|INDEX: sets the loaded scene's time (sy_scene_set_time) on that clip, or
  * on sy_cli_default_clip without one (a note says which, once), and commits. Returns 0; 2 after a

@@ -4,6 +4,7 @@
 # (skins_and_morphs; no not_loaded); `sy render --at` at two times gives different images (EXR,
 # exr_equal) for the skinned COLLADA box and FBX tentacle. DirectX's anim_test.x names bones its
 # frames lack: the skin is dropped with a warning naming the bone and its two images are the same.
+# A .x file the test writes with two clips on one node plays its first (as a glTF file's alternatives).
 # Usage: anim_cli_test.sh SY EXR_EQUAL MODELS_DIR TMP. Skipped (77) when the models are absent.
 set -u
 SY=$1 EXR_EQUAL=$2 MODELS=$3 TMP=$4
@@ -37,6 +38,18 @@ PY
         [ $same = 1 ] || { echo "FAIL: $f: --at 0.2 and --at 0.7 give the same image (exr_equal $same)"; fail=1; } ;;
     esac
 done
+# a file whose clips drive the same node holds alternatives (an FBX file's takes): the first plays
+cat >"$TMP/two.x" <<'X'
+xof 0302txt 0064
+Frame Root {
+ FrameTransformMatrix { 1.0,0.0,0.0,0.0, 0.0,1.0,0.0,0.0, 0.0,0.0,1.0,0.0, 0.0,0.0,0.0,1.0;; }
+ Mesh { 3; 0.0;0.0;0.0;, 1.0;0.0;0.0;, 0.0;1.0;0.0;; 1; 3;0,1,2;; }
+}
+AnimationSet Up { Animation { {Root} AnimationKey { 2; 2; 0;3;0.0,0.0,0.0;;, 10;3;0.0,1.0,0.0;;; } } }
+AnimationSet Side { Animation { {Root} AnimationKey { 2; 2; 0;3;0.0,0.0,0.0;;, 10;3;1.0,0.0,0.0;;; } } }
+X
+"$SY" render "$TMP/two.x" -w 32 -h 32 --at 0.2 -o "$TMP/two.exr" >"$TMP/two.log" 2>&1 || { cat "$TMP/two.log"; echo "FAIL: sy render two.x"; fail=1; }
+grep -q "playing clip 0 (Up) of 2" "$TMP/two.log" || { cat "$TMP/two.log"; echo "FAIL: two.x: the first clip does not play alone"; fail=1; }
 rm -rf "$TMP"
 [ $fail = 0 ] && echo "ok: Assimp's animated samples list their clips and move under sy render --at"
 exit $fail
