@@ -121,6 +121,18 @@ static sy_result mesh_bones(asp_loader *L, const char *where, const struct aiMes
     return take_blob(L, wt, nv * inf * sizeof *wt, &p->weights);
 }
 
+/* the nodes by name: L->named, sorted by asp_create_nodes (name, then breadth-first order) */
+asp_named *asp_find_named(asp_loader *L, const char *name)
+{
+    size_t lo = 0, hi = L->named_count;
+    while (lo < hi) {
+        size_t mid = (lo + hi) / 2;
+        if (strcmp(asp_str(&L->named[mid].ai->mName), name) < 0) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo < L->named_count && !strcmp(asp_str(&L->named[lo].ai->mName), name) ? &L->named[lo] : NULL;
+}
+
 /* >>morph targets ----------------------------------------------------------------------------- */
 
 static sy_result mesh_targets(asp_loader *L, const char *where, const struct aiMesh *m, sy_primitive *p)

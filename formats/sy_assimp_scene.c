@@ -292,17 +292,6 @@ static int named_order(const void *a, const void *b)
     return c ? c : x->walk < y->walk ? -1 : x->walk > y->walk;
 }
 
-asp_named *asp_find_named(asp_loader *L, const char *name)
-{
-    size_t lo = 0, hi = L->named_count;
-    while (lo < hi) {
-        size_t mid = (lo + hi) / 2;
-        if (strcmp(asp_str(&L->named[mid].ai->mName), name) < 0) lo = mid + 1;
-        else hi = mid;
-    }
-    return lo < L->named_count && !strcmp(asp_str(&L->named[lo].ai->mName), name) ? &L->named[lo] : NULL;
-}
-
 /* The node named `name` (the first in breadth-first order), NULL when none. */
 static walk_node *find_named(walk_node **sorted, size_t n, const char *name)
 {

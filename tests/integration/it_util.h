@@ -222,6 +222,27 @@ static inline void it_set_translation(sy_scene *s, sy_node n, float x, float y, 
     MUST(sy_node_set_trs(s, n, t, q, one, err));
 }
 
+/* A node at (x, y, z) carrying a new perspective camera named name (yfov radians, znear 0.01, the
+ * image's aspect, infinite far plane), looking down -Z. */
+static inline sy_node it_camera_node(sy_scene *s, const char *name, float x, float y, float z, float yfov)
+{
+    sy_camera c;
+    sy_node n;
+    MUST(sy_camera_create(s, name, &c, err));
+    sy_camera_data cd = *sy_camera_get(s, c);
+    cd.name = (char *)name;
+    cd.projection = SY_PROJECTION_PERSPECTIVE;
+    cd.yfov = yfov;
+    cd.aspect = 0.0f;
+    cd.znear = 0.01f;
+    cd.zfar = 0.0f;
+    MUST(sy_camera_set(s, c, &cd, err));
+    MUST(sy_node_create(s, name, &n, err));
+    MUST(sy_node_set_camera(s, n, c, err));
+    it_set_translation(s, n, x, y, z);
+    return n;
+}
+
 /* Perspective view from (0, 0, dist) looking down -Z with a symmetric window of half-size tan_half. */
 static inline sy_camera_view it_view_down_z(float dist, float tan_half)
 {
@@ -259,15 +280,17 @@ static inline bool it_project(const sy_camera_view *v, const float p[3], uint32_
     return true;
 }
 
-/* The whole w x h image of ctx seen through view into *img (created here; the caller destroys it). */
-static inline sy_result it_render_full(sy_context *ctx, const sy_camera_view *view, uint32_t w, uint32_t h, sy_layer *img,
-                                       sy_error *err)
+/* The whole w x h image of ctx seen through view into *img (created here; the caller destroys it);
+ * samples: a progressive back-end's sample count (0: its default). */
+static inline sy_result it_render_full(sy_context *ctx, const sy_camera_view *view, uint32_t w, uint32_t h,
+                                       uint32_t samples, sy_layer *img, sy_error *err)
 {
     sy_render_request req;
     memset(&req, 0, sizeof req);
     req.camera = *view;
     req.full_width = req.rect_w = w;
     req.full_height = req.rect_h = h;
+    req.sample_count = samples;
     sy_result r = sy_layer_create(w, h, img, err);
     return r != SY_OK ? r : sy_context_render(ctx, &req, img, err);
 }

@@ -33,14 +33,7 @@ static sy_result render_with(const char *backend, sy_scene *s, uint32_t root, co
     sy_context *ctx = NULL;
     sy_result r = sy_context_create(s, backend, NULL, root, &ctx, err);
     if (r == SY_OK) r = sy_context_sync(ctx, err);
-    sy_render_request req;
-    memset(&req, 0, sizeof req);
-    req.camera = *view;
-    req.full_width = req.rect_w = W;
-    req.full_height = req.rect_h = H;
-    req.sample_count = 16;
-    if (r == SY_OK) r = sy_layer_create(W, H, img, err);
-    if (r == SY_OK) r = sy_context_render(ctx, &req, img, err);
+    if (r == SY_OK) r = it_render_full(ctx, view, W, H, 16, img, err);
     sy_context_release(ctx);
     return r;
 }

@@ -118,7 +118,7 @@ static void render_faces(const char *path, const char *backend, float means[3])
     const float eye[3] = {2.6f, 2.2f, 3.4f};
     sy_camera_view view = look_at(eye, 0.32f);
     sy_layer img;
-    MUST(it_render_full(ctx, &view, W, H, &img, err));
+    MUST(it_render_full(ctx, &view, W, H, 0, &img, err));
     for (int a = 0; a < 3; a++) {
         int u = (a + 1) % 3, w = (a + 2) % 3;
         float lo = INFINITY, hi = -INFINITY, sum = 0.0f;

@@ -127,16 +127,7 @@ static void build(fixture *fx)
     MUST(sy_node_create(s, "ball", &fx->ball, err));
     MUST(sy_node_set_mesh(s, fx->ball, ball, err));
     place_ball(fx, 0);
-    sy_camera c;
-    MUST(sy_camera_create(s, "cam", &c, err));
-    sy_camera_data cd = *sy_camera_get(s, c);
-    cd.name = "cam";
-    cd.yfov = 0.8f;
-    cd.znear = 0.01f;
-    MUST(sy_camera_set(s, c, &cd, err));
-    MUST(sy_node_create(s, "cam", &fx->cam_node, err));
-    MUST(sy_node_set_camera(s, fx->cam_node, c, err));
-    it_set_translation(s, fx->cam_node, 0, 0, 2.5f);
+    fx->cam_node = it_camera_node(s, "cam", 0, 0, 2.5f, 0.8f);
     sy_node kids[3] = {fx->wall, fx->ball, fx->cam_node};
     for (int i = 0; i < 3; ++i) MUST(sy_node_add_child(s, fx->root, kids[i], err));
     MUST(sy_scene_commit(s, NULL, err));

@@ -49,22 +49,6 @@ static void expect_restart(fixture *fx, const char *change)
     EXPECT_MSG(render(fx, 1) == 2, "%s: no accumulation after the restart", change);
 }
 
-static sy_node camera_node(sy_scene *s, const char *name, float z)
-{
-    sy_camera c;
-    MUST(sy_camera_create(s, name, &c, err));
-    sy_camera_data cd = *sy_camera_get(s, c);
-    cd.name = (char *)name;
-    cd.yfov = 0.8f;
-    cd.znear = 0.01f;
-    MUST(sy_camera_set(s, c, &cd, err));
-    sy_node n;
-    MUST(sy_node_create(s, name, &n, err));
-    MUST(sy_node_set_camera(s, n, c, err));
-    it_set_translation(s, n, 0, 0, z);
-    return n;
-}
-
 static void build(fixture *fx)
 {
     memset(fx, 0, sizeof *fx);
@@ -87,8 +71,8 @@ static void build(fixture *fx)
     MUST(sy_node_create(s, "lamp", &fx->lamp_node, err));
     MUST(sy_node_set_light(s, fx->lamp_node, fx->lamp, err));
     it_set_translation(s, fx->lamp_node, 0, 0, 1);
-    fx->cam_node = camera_node(s, "cam", 3.0f);
-    fx->spare_cam = camera_node(s, "spare", 5.0f);
+    fx->cam_node = it_camera_node(s, "cam", 0, 0, 3.0f, 0.8f);
+    fx->spare_cam = it_camera_node(s, "spare", 0, 0, 5.0f, 0.8f);
     MUST(sy_node_add_child(s, fx->root, fx->geo, err));
     MUST(sy_node_add_child(s, fx->root, fx->lamp_node, err));
     MUST(sy_node_add_child(s, fx->root, fx->cam_node, err));

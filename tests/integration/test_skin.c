@@ -16,19 +16,6 @@
 #define H 200
 
 
-/* The whole image; a progressive back-end's with 16 samples (its 1-sample edges are jittered). */
-static sy_result render(sy_context *ctx, const sy_camera_view *view, sy_layer *img, sy_error *err)
-{
-    sy_render_request req;
-    memset(&req, 0, sizeof req);
-    req.camera = *view;
-    req.full_width = req.rect_w = W;
-    req.full_height = req.rect_h = H;
-    req.sample_count = 16;
-    sy_result r = sy_layer_create(W, H, img, err);
-    return r != SY_OK ? r : sy_context_render(ctx, &req, img, err);
-}
-
 /* The view sy render makes without a camera (sy_camera_view_frame_bounds of the root's world bounds,
  * as core/sy_viewport.c) frames the skinned model whole at each time: whitted's image of it covers
  * no pixel of the image's border, and some pixel. A framing from bounds that ignored the pose (or
@@ -50,7 +37,7 @@ static void framed_whole(const char *path, const double *times, int n)
         MUST(sy_node_world_bounds(s, info.root, &b, err));
         sy_camera_view view = sy_camera_view_frame_bounds(&b, (float)W / (float)H);
         sy_layer img;
-        MUST(render(ctx, &view, &img, err));
+        MUST(it_render_full(ctx, &view, W, H, 16, &img, err));
         uint32_t x0 = W, x1 = 0, y0 = H, y1 = 0, edge = 0;
         for (uint32_t y = 0; y < H; ++y)
             for (uint32_t x = 0; x < W; ++x) {
@@ -88,7 +75,7 @@ int main(void)
     for (size_t b = 0; b < IT_NBACKENDS; ++b) {
         MUST(sy_context_create(s, it_backends[b], NULL, info.root.id, &ctx[b], err));
         MUST(sy_context_sync(ctx[b], err));
-        MUST(render(ctx[b], &view, &t0[b], err));
+        MUST(it_render_full(ctx[b], &view, W, H, 16, &t0[b], err));
     }
     MUST(sy_scene_set_time(s, (sy_animation){0}, 1.0, err));
     MUST(sy_scene_commit(s, NULL, err));
@@ -97,7 +84,7 @@ int main(void)
     for (size_t b = 0; b < IT_NBACKENDS; ++b) {
         MUST(sy_context_sync(ctx[b], err));
         if (b + 1 == IT_NBACKENDS) sy_deform_cache_stats_get(&dc1);
-        MUST(render(ctx[b], &view, &t1[b], err));
+        MUST(it_render_full(ctx[b], &view, W, H, 16, &t1[b], err));
         double iou;
         MUST(sy_layer_coverage_iou(&t0[b], &t1[b], &iou, err));
         printf("%s: IoU of t=0 and t=1: %.4f\n", it_backends[b], iou);

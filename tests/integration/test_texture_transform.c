@@ -72,7 +72,7 @@ static void check_backend(sy_scene *s, const sy_gltf_info *info, const char *bac
     sy_camera_view view = it_view_down_z(4.0f, 0.45f);
     view.window[2] = -0.45f * (float)H / (float)W, view.window[3] = 0.45f * (float)H / (float)W;
     sy_layer img;
-    MUST(it_render_full(ctx, &view, W, H, &img, err));
+    MUST(it_render_full(ctx, &view, W, H, 0, &img, err));
 
     /* top row: the quads (half-size 0.5) at x = -1.1, 0, 1.1, y = 0.55 */
     const float top_x[3] = {-1.1f, 0.0f, 1.1f};

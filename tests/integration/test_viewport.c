@@ -121,25 +121,6 @@ static void test_composite_math(void)
 }
 
 /* ---------------------------------------------------------------- scenes */
-static sy_node camera_node(sy_scene *s, float x, float y, float z, float yfov)
-{
-    sy_camera cam;
-    sy_node n;
-    MUST(sy_camera_create(s, "cam", &cam, err));
-    sy_camera_data cd = *sy_camera_get(s, cam);
-    cd.name = "cam";
-    cd.projection = SY_PROJECTION_PERSPECTIVE;
-    cd.yfov = yfov;
-    cd.aspect = 0.0f;
-    cd.znear = 0.01f;
-    cd.zfar = 0.0f;
-    MUST(sy_camera_set(s, cam, &cd, err));
-    MUST(sy_node_create(s, "camera", &n, err));
-    MUST(sy_node_set_camera(s, n, cam, err));
-    it_set_translation(s, n, x, y, z);
-    return n;
-}
-
 /* A visible node with one unlit quad of half-size h centred at (x, y, z). */
 static sy_node quad_node(sy_scene *s, const char *name, float x, float y, float z, float h, sy_material m)
 {
@@ -174,7 +155,7 @@ static void test_layered(void)
     /* A: near (z = 0) square left of centre; B: a second root, farther (z = -1), overlapping A */
     sy_node a = quad_node(s, "A", -0.6f, 0.0f, 0.0f, 0.5f, ma);
     sy_node b = quad_node(s, "B", 0.0f, 0.0f, -1.0f, 0.5f, mb);
-    sy_node cam = camera_node(s, 0, 0, 4, 0.8f);
+    sy_node cam = it_camera_node(s, "cam", 0, 0, 4, 0.8f);
     MUST(sy_scene_commit(s, NULL, err));
     EXPECT(sy_node_parent_count(s, a) == 0 && sy_node_parent_count(s, b) == 0);
 
@@ -354,7 +335,7 @@ static void test_stereo_render(void)
     /* camera at z = 3: the zero-parallax quad at z = 1 (distance 2), the near one at z = 2 (distance 1) */
     MUST(sy_node_add_child(s, root, quad_node(s, "on zero parallax", -0.4f, 0.1f, 1.0f, 0.15f, mz), err));
     MUST(sy_node_add_child(s, root, quad_node(s, "near", 0.15f, -0.1f, 2.0f, 0.08f, mn), err));
-    sy_node cam = camera_node(s, 0, 0, 3, 1.0f);
+    sy_node cam = it_camera_node(s, "cam", 0, 0, 3, 1.0f);
     MUST(sy_scene_commit(s, NULL, err));
 
     const uint32_t half = 96, h = 96;

@@ -303,7 +303,7 @@ static void test_select(void)
             MUST(sy_viewport_camera_view(v.vp, ss.s, W, H, &cv, err));
             sy_context *ctx = view_context(&v, ss.s);
             sy_layer full = {0}, tile = {0};
-            MUST(it_render_full(ctx, &cv, W, H, &full, err));
+            MUST(it_render_full(ctx, &cv, W, H, 0, &full, err));
             uint32_t differ = 0, outline_differ = 0;
             for (uint32_t t = 0; t < 4; ++t) { /* 2 x 2 tiles split through the caster's middle */
                 uint32_t tx = t % 2 ? W / 2 : 0, ty = t / 2 ? H / 2 : 0;

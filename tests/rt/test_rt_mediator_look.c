@@ -15,22 +15,6 @@
 #define W 32
 #define H 24
 
-static sy_node camera_node(sy_scene *s, float z)
-{
-    sy_camera c;
-    MUST(sy_camera_create(s, "cam", &c, err));
-    sy_camera_data cd = *sy_camera_get(s, c);
-    cd.name = "cam";
-    cd.yfov = 0.8f;
-    cd.znear = 0.01f;
-    MUST(sy_camera_set(s, c, &cd, err));
-    sy_node n;
-    MUST(sy_node_create(s, "cam", &n, err));
-    MUST(sy_node_set_camera(s, n, c, err));
-    it_set_translation(s, n, 0, 0, z);
-    return n;
-}
-
 static float lum(const float *p) { return 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2]; }
 
 typedef struct fixture {
@@ -83,7 +67,7 @@ int main(void)
     sy_node geo;
     MUST(sy_node_create(s, "geo", &geo, err));
     MUST(sy_node_set_mesh(s, geo, mesh, err));
-    fx.cam = camera_node(s, 3.0f);
+    fx.cam = it_camera_node(s, "cam", 0, 0, 3.0f, 0.8f);
     MUST(sy_node_add_child(s, fx.root, geo, err));
     MUST(sy_node_add_child(s, fx.root, fx.cam, err));
     MUST(sy_background_create(s, "world", &fx.bg, err));

@@ -32,7 +32,7 @@ static void render_moving(sy_context *ctx, const sy_camera_view *open, const sy_
     MUST(sy_context_motion_open(ctx, &native, err));
     EXPECT_MSG(native, "a motion of nothing is not native");
     for (int i = 0; i < n; ++i) MUST(sy_context_motion_camera(ctx, &open[i], 2, &close[i], err));
-    MUST(it_render_full(ctx, want, W, H, img, err));
+    MUST(it_render_full(ctx, want, W, H, 0, img, err));
     sy_context_motion_end(ctx);
 }
 
@@ -59,7 +59,7 @@ int main(void)
         sy_camera_view open[2] = {view_at(-0.03f), view_at(0.03f)}, close[2] = {view_at(0.27f), view_at(0.33f)};
         sy_layer sharp = {0}, left_alone = {0}, right_alone = {0}, left_both = {0}, right_both = {0}, left_replaced = {0};
         sy_context_restart(ctx);
-        MUST(it_render_full(ctx, &open[0], W, H, &sharp, err));
+        MUST(it_render_full(ctx, &open[0], W, H, 0, &sharp, err));
         render_moving(ctx, open, close, 1, &open[0], &left_alone);
         render_moving(ctx, open + 1, close + 1, 1, &open[1], &right_alone);
         render_moving(ctx, open, close, 2, &open[0], &left_both);
