@@ -28,15 +28,12 @@ static void rt_destroy(void *state)
         sy_radiance_hook_destroy(st->slots[i].radiance);
     }
     for (int k = 0; k <= SY_RT_AOV_COUNT; ++k) free(st->fbuf[k]);
-    sy_filter_temporal_destroy(st->temporal);
+    sy_rti_temporal_free(st);
     sy_rt_device_destroy(st->dev);
     sy_mirror_map_free(&st->inst_node);
     sy_mirror_map_free(&st->motion_rec);
     sy_mirror_map_free(&st->inst_sel);
     sy_mirror_map_free(&st->inst_place);
-    sy_mirror_map_free(&st->temporal_from);
-    free(st->motion_ids);
-    free(st->motion_buf);
     free(st);
 }
 

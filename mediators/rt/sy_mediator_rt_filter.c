@@ -418,6 +418,14 @@ static sy_result object_motion(rt_state *st, const sy_render_request *req, const
 static sy_result temporal_frame(rt_state *st, const sy_render_request *req, uint32_t samples, bool moved,
                                 sy_layer *layer, bool *done, sy_error *err);
 
+void sy_rti_temporal_free(rt_state *st)
+{
+    sy_filter_temporal_destroy(st->temporal);
+    sy_mirror_map_free(&st->temporal_from);
+    free(st->motion_ids);
+    free(st->motion_buf);
+}
+
 sy_result sy_rti_temporal_layer(rt_state *st, const sy_render_request *req, uint32_t samples, sy_layer *layer,
                                 bool *done, sy_error *err)
 {

@@ -217,6 +217,9 @@ sy_result sy_rti_filter_layer(rt_state *st, const sy_render_request *req, sy_lay
  * layer alone (*done false). Records the camera either way. */
 sy_result sy_rti_temporal_layer(rt_state *st, const sy_render_request *req, uint32_t samples, sy_layer *layer,
                                 bool *done, sy_error *err);
+/* Frees temporal reuse's state (the filter, the moved instances' matrices, the motion planes);
+ * the context's destroy calls it. */
+void sy_rti_temporal_free(rt_state *st);
 /* Whether a path-traced render of req is a moving frame for temporal reuse: the camera moved since
  * the previous render, or only instances moved since (object motion); false while it is off. */
 bool sy_rti_temporal_moving(const rt_state *st, const sy_render_request *req);

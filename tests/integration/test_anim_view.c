@@ -146,18 +146,6 @@ static sy_camera_view rig_time(rig *g, double t)
     return v;
 }
 
-static void render(sy_context *ctx, const sy_camera_view *view, uint32_t spp, sy_layer *img)
-{
-    sy_render_request req;
-    memset(&req, 0, sizeof req);
-    req.camera = *view;
-    req.full_width = req.rect_w = W;
-    req.full_height = req.rect_h = H;
-    req.sample_count = spp;
-    MUST(sy_layer_create(W, H, img, err));
-    MUST(sy_context_render(ctx, &req, img, err));
-}
-
 /* Opens the rig of the file `name`, renders it at t = 0 and t = 1 on every back-end (spp samples
  * a pixel) and hands each image to measure (ti: 0 or 1, bi: the back-end's index); closes the rig. */
 typedef void (*rig_measure)(void *arg, int ti, double t, size_t bi, const sy_layer *img);
@@ -170,7 +158,7 @@ static void rig_sweep(const char *name, uint32_t spp, rig_measure measure, void 
         sy_camera_view v = rig_time(&g, times[ti]);
         for (size_t bi = 0; bi < IT_NBACKENDS; ++bi) {
             sy_layer img;
-            render(g.ctx[bi], &v, spp, &img);
+            MUST(it_render_full(g.ctx[bi], &v, W, H, spp, &img, err));
             measure(arg, ti, times[ti], bi, &img);
             sy_layer_destroy(&img);
         }
