@@ -140,7 +140,8 @@ static sy_result mesh_targets(asp_loader *L, const char *where, const struct aiM
     size_t nv = m->mNumVertices, nt = m->mNumAnimMeshes;
     const char *why = NULL;
     bool normals = m->mNormals != NULL;
-    if (nt > SY_MORPH_MAX_TARGETS || !m->mAnimMeshes) why = "more than SY_MORPH_MAX_TARGETS";
+    if (nt > SY_MORPH_MAX_TARGETS) why = "more than SY_MORPH_MAX_TARGETS";
+    else if (!m->mAnimMeshes) why = "no anim mesh array";
     for (size_t t = 0; t < nt && !why; ++t) {
         const struct aiAnimMesh *am = m->mAnimMeshes[t];
         if (!am || am->mNumVertices != nv || !am->mVertices) why = "an anim mesh without positions, or not of the mesh's vertex count";
