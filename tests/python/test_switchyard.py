@@ -308,12 +308,13 @@ def _ws_message(port, kind, timeout=30):
 
 def test_serve_plays_the_clip_given(tmp_path):
     """serve(..., clip=NAME|INDEX) is sy web --clip (sy_web_desc.clip): the page's clock plays that
-    clip (its index in hello's clips), every clip together without it; an unknown clip, or a clip of
-    a scene without animations, raises NotFoundError before anything serves."""
+    clip (its index in hello's clips); without it the clip sy web plays without --clip (two clips on
+    the same node: the first); an unknown clip, or a clip of a scene without animations, raises
+    NotFoundError before anything serves."""
     if not hasattr(switchyard._c, "_Web"):
         pytest.skip("built without the web view (SY_WITH_WEB)")
     path = _two_clips_gltf(tmp_path / "clips.gltf")
-    for clip, index in (("lift", 1), (0, 0), ("1", 1), (None, -1)):
+    for clip, index in (("lift", 1), (0, 0), ("1", 1), (None, 0)):
         with switchyard.serve(path, port=0, backend=NAMES[0], clip=clip) as srv:
             assert _ws_message(srv.port, "hello")["clips"] == ["slide", "lift"]
             clock = _ws_message(srv.port, "clock")
@@ -322,6 +323,21 @@ def test_serve_plays_the_clip_given(tmp_path):
         switchyard.serve(path, port=0, clip="walk")
     with pytest.raises(switchyard.NotFoundError, match="no animations"):
         switchyard.serve("demo", port=0, clip=0)
+
+
+@needs_whitted
+def test_default_clip_is_sy_renders(tmp_path):
+    """Without clip=, load(at=) and Scene.set_time play the clip sy render plays without --clip (two
+    clips on one node: the first, "slide"), not every clip together ("lift" would win)."""
+    path = _two_clips_gltf(tmp_path / "clips.gltf")
+    ref = sy_render(path, str(tmp_path / "ref.exr"), "-b", "whitted", "-w", "48", "-h", "40", "--at", "0.5")
+    assert_same_pixels(switchyard.render(path, backend="whitted", width=48, height=40, at=0.5), ref)
+    with switchyard.load(path) as s:
+        s.set_time(0.5)
+        slide = s.render(backend="whitted", width=48, height=40)
+        assert_same_pixels(slide, ref)
+        s.set_time(0.5, clip="lift")
+        assert not numpy.array_equal(s.render(backend="whitted", width=48, height=40), slide)
 
 
 @needs_whitted

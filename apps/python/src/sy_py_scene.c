@@ -122,13 +122,15 @@ static int time_from_python(PyObject *at, double *seconds)
     return 0;
 }
 
-/* The scene's time (sy render --at / --clip): every clip (clip NULL) or one, evaluated at seconds,
- * committed. A scene without animations is left as it is (a note on the log) unless a clip is
- * named (NotFoundError). 0, or -1 with an exception. */
-static int scene_time(sy_scene *sc, const char *clip, double seconds)
+/* The scene's time (sy render --at / --clip): the clip named, or without one the clip sy render
+ * plays by default (sy_cli_default_clip: a glTF's first of clips that drive the same objects, else
+ * every clip), evaluated at seconds, committed. A scene without animations is left as it is (a
+ * note on the log) unless a clip is named (NotFoundError). 0, or -1 with an exception. */
+static int scene_time(loaded *ld, const char *clip, double seconds)
 {
     sy_error err = {0};
-    sy_animation a = {0};
+    sy_scene *sc = ld->scene;
+    sy_animation a = sy_cli_default_clip(ld);
     if (!sy_scene_count(sc, SY_TYPE_ANIMATION)) {
         if (clip) {
             sy_error_set(&err, SY_ERR_NOT_FOUND, "clip %s: the scene has no animations", clip);
@@ -225,7 +227,7 @@ PyObject *sy_py_load(PyObject *self, PyObject *args, PyObject *kw)
         sy_py_raise(r, &err);
         goto done;
     }
-    if ((at != Py_None || clip) && scene_time(s->ld.scene, clip, seconds)) {
+    if ((at != Py_None || clip) && scene_time(&s->ld, clip, seconds)) {
         Py_DECREF(s);
         goto done;
     }
@@ -553,8 +555,8 @@ static PyObject *scene_set_time(PyObject *self, PyObject *args)
     const char *clip = NULL;
     double seconds;
     if (!PyArg_ParseTuple(args, "O|z", &at, &clip) || time_from_python(at, &seconds)) return NULL;
-    sy_scene *sc = sy_py_scene_use((SceneObject *)self);
-    if (!sc || scene_time(sc, clip, seconds)) return NULL;
+    SceneObject *s = (SceneObject *)self;
+    if (!sy_py_scene_use(s) || scene_time(&s->ld, clip, seconds)) return NULL;
     Py_RETURN_NONE;
 }
 

@@ -51,7 +51,8 @@ static void web_dealloc(PyObject *self)
 
 /* _Web(scene, backend=None, listen=None, token=None, max_width=0, max_height=0, quality=0,
  * filter=None, threshold=0, budget_ms=0, clip=None): serving starts at once; clip (a name or an
- * index, as sy web --clip: sy_animation_find) is the clip the timeline plays (None: every clip) */
+ * index, as sy web --clip: sy_animation_find) is the clip the timeline plays (None: as sy web
+ * without --clip, sy_cli_default_clip) */
 static PyObject *web_new(PyTypeObject *type, PyObject *args, PyObject *kw)
 {
     static char *kwlist[] = {"scene", "backend", "listen", "token", "max_width", "max_height", "quality", "filter",
@@ -75,7 +76,7 @@ static PyObject *web_new(PyTypeObject *type, PyObject *args, PyObject *kw)
         return sy_py_raise(SY_ERR_INVALID_ARGUMENT,
                         &(sy_error){SY_ERR_INVALID_ARGUMENT, "serve: the scene has no camera (add one: scene.camera = "
                                                              "scene.add_camera(...))"});
-    sy_animation played = {0}; /* every clip together unless clip names one (as sy web --clip) */
+    sy_animation played = sy_cli_default_clip(&s->ld); /* as sy web: --clip, else its default */
     if (clip && !sy_scene_count(sc, SY_TYPE_ANIMATION))
         return sy_py_raise(sy_error_set(&err, SY_ERR_NOT_FOUND, "serve: clip %s: the scene has no animations", clip), &err);
     if (clip && (r = sy_animation_find(sc, clip, &played, &err)) != SY_OK) {
