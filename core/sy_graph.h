@@ -24,7 +24,10 @@ uint32_t sy_node_parent_count(const sy_scene *s, sy_node n);
 sy_node sy_node_parent(const sy_scene *s, sy_node n, uint32_t i);
 /** World matrix of the node along its primary path. */
 sy_result sy_node_world_matrix(const sy_scene *s, sy_node n, sy_mat4 *out, sy_error *err);
-/** World-space bounds of the node's subtree (its mesh and all descendants), primary path. */
+/** World-space bounds of the node's subtree (its mesh and all descendants), primary path. A skinned
+ *  mesh counts where its joints put it (each joint's bind-pose vertices placed by joint world x
+ *  inverse bind: a box around the deformed mesh, not the bind pose's), updated when a joint moves;
+ *  morph targets are not counted (the base shape's bounds). */
 sy_result sy_node_world_bounds(const sy_scene *s, sy_node n, sy_bounds *out, sy_error *err);
 /** Local bounds of a mesh (all primitives). */
 sy_result sy_mesh_bounds(const sy_scene *s, sy_mesh m, sy_bounds *out, sy_error *err);

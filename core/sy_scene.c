@@ -175,6 +175,9 @@ void sy_scene_destroy(sy_scene *s)
     free(s->dirty);
     free(s->world_dirty.items);
     free(s->bounds_dirty.items);
+    free(s->skinned.items);
+    for (uint32_t i = 0; i < s->skin_mesh_count; ++i) free(s->skin_meshes[i].bounds);
+    free(s->skin_meshes);
     free(s->stack.items);
     free(s);
 }

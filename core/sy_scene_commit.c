@@ -61,6 +61,7 @@ static void compact(sy_scene *s)
 sy_result sy_scene_commit(sy_scene *s, uint64_t *frame_out, sy_error *err)
 {
     sy_sc_update_world(s);
+    sy_sc_mark_skins_moved(s);
     sy_sc_update_bounds(s);
     bool record = any_consumer(s);
     sy_changes *c = NULL;

@@ -70,6 +70,7 @@ void sy_sc_update_world(sy_scene *s)
 {
     uint32_t updates = 0;
     id_list *st = &s->stack;
+    if (s->world_dirty.count) s->world_stamp++;
     for (uint32_t i = 0; i < s->world_dirty.count; ++i) {
         if (!walk_from_dirty(s, s->world_dirty.items[i], true)) continue;
         while (st->count) {
@@ -85,6 +86,7 @@ void sy_sc_update_world(sy_scene *s)
             if (pnx) above.world = pnx->world;
             nx->world = sy_placement_child(pnx ? &above : NULL, &d->transform.matrix, d->flags).world;
             nx->world_dirty = 0;
+            nx->world_stamp = s->world_stamp;
             updates++;
             uint32_t nc;
             const uint32_t *ch = sy_node_children(d, &nc);
@@ -96,6 +98,95 @@ void sy_sc_update_world(sy_scene *s)
     }
     s->world_dirty.count = 0;
     s->last_world_updates = updates;
+}
+
+/* >>skinned bounds
+ * A skinned mesh is placed by its joints, not its node (glTF; the deformer, mediators/sy_deform, puts
+ * each vertex at sum_k w_k (joint_k world x inverse_bind_k) p in world space). Its bounds are the
+ * union over the joint indices of each joint's bind-pose vertex bounds (sy_sc_mesh_joint_bounds,
+ * once per mesh's primitives) placed by that joint's matrix: a vertex blended from several joints (weights
+ * summing to 1) lies in the hull of its placements, so inside the union. The box is brought into
+ * the node's frame (local_bounds) through the inverse of the node's world matrix. Morph targets
+ * are not counted (bind-shape bounds). */
+static int skin_mesh_cmp(const void *key, const void *e)
+{
+    uint32_t a = *(const uint32_t *)key, b = ((const skin_mesh *)e)->mesh;
+    return a < b ? -1 : a > b;
+}
+
+skin_mesh *sy_sc_skin_mesh_find(const sy_scene *s, uint32_t mesh_id)
+{
+    return s->skin_mesh_count ? bsearch(&mesh_id, s->skin_meshes, s->skin_mesh_count, sizeof *s->skin_meshes, skin_mesh_cmp)
+                              : NULL;
+}
+
+/* (public, sy_objects.h; here, below the setters' module, for the skinned bounds) */
+const sy_skin_joint *sy_node_skin(const sy_node_data *d, uint32_t *count_out)
+{
+    *count_out = d && d->skin ? (uint32_t)(sy_blob_size(d->skin) / sizeof(sy_skin_joint)) : 0;
+    return *count_out ? (const sy_skin_joint *)sy_blob_data(d->skin) : NULL;
+}
+
+/* The nodes whose skin places a mesh with joint bounds (rebuilt after a skin or mesh field changed). */
+static void skinned_rebuild(sy_scene *s)
+{
+    s->skinned.count = 0;
+    s->skinned_stale = false;
+    const pool *p = &s->pools[SY_TYPE_NODE];
+    for (uint32_t i = 1; i < p->count; ++i) {
+        const slot *sl = &p->slots[i];
+        if (!sl->alive) continue;
+        const sy_node_data *d = sl->data;
+        uint32_t nj = 0;
+        if (d->skin && sy_sc_skin_mesh_find(s, d->mesh.id) && sy_node_skin(d, &nj) && nj &&
+            !sy_sc_list_push(&s->skinned, make_id(i, sl->generation))) {
+            s->skinned_stale = true; /* out of memory: try again next commit */
+            return;
+        }
+    }
+}
+
+/* After sy_sc_update_world: a skinned node whose joints (or itself) moved needs new bounds. */
+void sy_sc_mark_skins_moved(sy_scene *s)
+{
+    if (s->skinned_stale) skinned_rebuild(s);
+    if (!s->last_world_updates) return;
+    for (uint32_t i = 0; i < s->skinned.count; ++i) {
+        uint32_t id = s->skinned.items[i];
+        slot *sl = sy_sc_lookup(s, SY_TYPE_NODE, id);
+        if (!sl) continue;
+        bool moved = sl->nx->world_stamp == s->world_stamp;
+        uint32_t nj = 0;
+        const sy_skin_joint *sj = sy_node_skin(sl->data, &nj);
+        for (uint32_t j = 0; j < nj && !moved; ++j) {
+            const node_extra *jx = sy_sc_nx_of(s, sj[j].node);
+            moved = jx && jx->world_stamp == s->world_stamp;
+        }
+        if (moved) sy_sc_mark_bounds_dirty(s, id);
+    }
+}
+
+/* The bounds of a node's own mesh in the node's frame (skinned: above). */
+static sy_bounds own_mesh_bounds(const sy_scene *s, const node_extra *nx, const sy_node_data *d, const slot *ms)
+{
+    uint32_t nj = 0;
+    const sy_skin_joint *sj = sy_node_skin(d, &nj);
+    const skin_mesh *sm = nj ? sy_sc_skin_mesh_find(s, d->mesh.id) : NULL;
+    sy_mat4 inv;
+    if (!sm || !sy_mat4_invert(&nx->world, &inv)) return ms->bounds;
+    sy_bounds w = sm->bounds[sm->count]; /* the vertices no joint moves stay as they are */
+    for (uint32_t j = 0; j < sm->count; ++j) {
+        if (sy_bounds_is_empty(&sm->bounds[j])) continue;
+        if (j >= nj) { /* past the skin: drawn undeformed */
+            sy_bounds_add_bounds(&w, &sm->bounds[j]);
+            continue;
+        }
+        const node_extra *jx = sy_sc_nx_of(s, sj[j].node);
+        sy_mat4 m = jx ? sy_mat4_mul(&jx->world, &sj[j].inverse_bind) : sj[j].inverse_bind; /* unplaced: identity */
+        sy_bounds pb = sy_bounds_transform(&sm->bounds[j], &m);
+        sy_bounds_add_bounds(&w, &pb);
+    }
+    return sy_bounds_transform(&w, &inv);
 }
 
 /* Recomputes local bounds of bounds-dirty nodes in post order (children first). */
@@ -129,7 +220,7 @@ void sy_sc_update_bounds(sy_scene *s)
             st->count--;
             sy_bounds b = sy_bounds_empty();
             slot *ms = sy_sc_lookup(s, SY_TYPE_MESH, d->mesh.id);
-            if (ms) b = ms->bounds;
+            if (ms) b = own_mesh_bounds(s, sl->nx, d, ms);
             for (uint32_t k = 0; k < nc; ++k) {
                 slot *cs = sy_sc_lookup(s, SY_TYPE_NODE, ch[k]);
                 if (!cs || cs->nx->bounds_dirty) continue; /* a cycle from bad input: ignore */

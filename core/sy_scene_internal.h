@@ -19,6 +19,7 @@ typedef struct node_extra {
     sy_bounds local_bounds; /* subtree bounds in the node's own frame (before its transform) */
     uint8_t world_dirty, bounds_dirty;
     uint32_t mark; /* traversal epoch */
+    uint32_t world_stamp; /* the scene's world_stamp when the world matrix was last recomputed */
 } node_extra;
 
 typedef struct slot {
@@ -58,6 +59,14 @@ typedef struct consumer {
     uint64_t cursor; /* frames <= cursor have been delivered */
 } consumer;
 
+/* A mesh with skinned triangles: per joint index, the bind-pose bounds of the vertices it moves
+ * (weight > 0); bounds[count] the vertices no joint moves (sy_scene_graph.c: skinned bounds). Kept
+ * beside the slots (a slot's size is the replica's memory unit, SY_SCENE_SLOT_BYTES). */
+typedef struct skin_mesh {
+    uint32_t mesh, count;
+    sy_bounds *bounds;
+} skin_mesh;
+
 typedef struct id_list {
     uint32_t *items;
     uint32_t count, capacity;
@@ -76,6 +85,11 @@ struct sy_scene {
     id_list world_dirty, bounds_dirty, stack;
     uint32_t epoch;
     uint32_t last_world_updates;
+    uint32_t world_stamp; /* counts sy_sc_update_world calls that recomputed a world matrix */
+    id_list skinned;      /* nodes with a skin and a skin_mesh (rebuilt when skinned_stale) */
+    bool skinned_stale;
+    skin_mesh *skin_meshes; /* by mesh id, ascending */
+    uint32_t skin_mesh_count, skin_mesh_capacity;
     bool applying; /* replica apply: references may be stale, cycles checked afterwards */
     uint32_t apply_max_slots; /* replica policy: highest slot index + 1 a change list may create (0 = none) */
 };
@@ -102,7 +116,9 @@ void sy_sc_mark_world_dirty(sy_scene *s, uint32_t node_id);
 void sy_sc_mark_bounds_dirty(sy_scene *s, uint32_t node_id);
 void sy_sc_mark_parents_bounds_dirty(sy_scene *s, uint32_t node_id);
 void sy_sc_update_world(sy_scene *s);
+void sy_sc_mark_skins_moved(sy_scene *s);
 void sy_sc_update_bounds(sy_scene *s);
+skin_mesh *sy_sc_skin_mesh_find(const sy_scene *s, uint32_t mesh_id);
 bool sy_sc_reaches(sy_scene *s, const uint32_t *from, uint32_t n, uint32_t target);
 bool sy_sc_find_cycle(sy_scene *s, const sy_changes *changes, uint32_t *at);
 int sy_sc_cmp_u32(const void *a, const void *b);
@@ -113,6 +129,7 @@ sy_result sy_sc_validate_object(const sy_scene *s, uint32_t type, uint32_t id, c
 
 /* sy_scene_objects.c */
 sy_result sy_sc_object_create_at(sy_scene *s, uint32_t t, uint32_t id, sy_error *err);
+void sy_sc_mesh_joint_bounds(sy_scene *s, uint32_t mesh_id, const sy_mesh_data *d);
 sy_result sy_sc_set_attachments(sy_scene *s, uint32_t t, uint32_t id, slot *sl, sy_attachment *a, uint32_t n,
                                  sy_error *err);
 

@@ -123,7 +123,7 @@ static void mesh_users_changed(sy_scene *s, uint32_t node_id, uint32_t old_mesh,
     sy_sc_mark_bounds_dirty(s, node_id);
 }
 
-static void mesh_bounds_update(sy_scene *s, slot *sl)
+static void mesh_bounds_update(sy_scene *s, uint32_t id, slot *sl)
 {
     const sy_mesh_data *d = sl->data;
     sy_bounds b = sy_bounds_empty();
@@ -140,7 +140,86 @@ static void mesh_bounds_update(sy_scene *s, slot *sl)
         sy_bounds_add_bounds(&b, &pb);
     }
     sl->bounds = b;
+    sy_sc_mesh_joint_bounds(s, id, d);
     for (uint32_t i = 0; i < sl->user_count; ++i) sy_sc_mark_bounds_dirty(s, sl->users[i]);
+}
+
+/* >>skinned bounds (sy_scene_graph.c): each skinned mesh's per-joint bind-pose bounds */
+/* Per joint index, the bind-pose bounds of the vertices it moves; *count the joint indices (0: no
+ * skinned triangles, NULL returned); [count] the vertices no joint moves. NULL without memory too
+ * (the node keeps the mesh's bind-pose bounds). */
+static sy_bounds *joint_bounds(const sy_mesh_data *d, uint32_t *count)
+{
+    uint32_t nj = 0;
+    *count = 0;
+    for (uint32_t i = 0; i < d->primitives.count; ++i) {
+        const sy_primitive *pr = &d->primitives.items[i];
+        uint32_t inf = sy_primitive_influences(pr), nv = sy_primitive_vertex_count(pr);
+        if (pr->topology != SY_TOPOLOGY_TRIANGLES || !inf || !pr->joints || !pr->weights) continue;
+        const uint32_t *jj = sy_blob_data(pr->joints);
+        for (size_t k = 0; k < (size_t)inf * nv; ++k)
+            if (jj[k] < SY_SKIN_MAX_JOINTS && jj[k] >= nj) nj = jj[k] + 1u;
+    }
+    sy_bounds *jb = nj ? malloc(sizeof *jb * (nj + 1u)) : NULL;
+    if (!jb) return NULL;
+    for (uint32_t j = 0; j <= nj; ++j) jb[j] = sy_bounds_empty();
+    for (uint32_t i = 0; i < d->primitives.count; ++i) {
+        const sy_primitive *pr = &d->primitives.items[i];
+        uint32_t inf = sy_primitive_influences(pr), nv = sy_primitive_vertex_count(pr);
+        if (pr->topology != SY_TOPOLOGY_TRIANGLES) continue;
+        const float *pos = sy_blob_data(pr->positions);
+        const uint32_t *jj = inf && pr->joints && pr->weights ? sy_blob_data(pr->joints) : NULL;
+        const float *ww = jj ? sy_blob_data(pr->weights) : NULL;
+        for (uint32_t v = 0; v < nv; ++v) {
+            bool moved = false;
+            for (uint32_t k = 0; jj && k < inf; ++k) {
+                uint32_t j = jj[(size_t)inf * v + k];
+                if (ww[(size_t)inf * v + k] != 0.0f && j < nj) {
+                    sy_bounds_add_point(&jb[j], &pos[3 * (size_t)v]);
+                    moved = true;
+                }
+            }
+            if (!moved) sy_bounds_add_point(&jb[nj], &pos[3 * (size_t)v]);
+        }
+    }
+    *count = nj;
+    return jb;
+}
+
+void sy_sc_mesh_joint_bounds(sy_scene *s, uint32_t mesh_id, const sy_mesh_data *d)
+{
+    skin_mesh *e = sy_sc_skin_mesh_find(s, mesh_id);
+    uint32_t count = 0;
+    sy_bounds *jb = d ? joint_bounds(d, &count) : NULL;
+    if (e && jb) { /* replaced */
+        free(e->bounds);
+        e->bounds = jb, e->count = count;
+        return;
+    }
+    if (e) { /* no skinned triangles any more, or the mesh is gone */
+        free(e->bounds);
+        size_t at = (size_t)(e - s->skin_meshes);
+        memmove(e, e + 1, sizeof *e * (s->skin_mesh_count - at - 1u));
+        s->skin_mesh_count--;
+        s->skinned_stale = true;
+        return;
+    }
+    if (!jb) return;
+    if (s->skin_mesh_count == s->skin_mesh_capacity) {
+        uint32_t nc = s->skin_mesh_capacity ? 2u * s->skin_mesh_capacity : 8u;
+        skin_mesh *g = realloc(s->skin_meshes, sizeof *g * nc);
+        if (!g) { /* without memory: bind-pose bounds */
+            free(jb);
+            return;
+        }
+        s->skin_meshes = g, s->skin_mesh_capacity = nc;
+    }
+    uint32_t at = 0;
+    while (at < s->skin_mesh_count && s->skin_meshes[at].mesh < mesh_id) at++;
+    memmove(&s->skin_meshes[at + 1], &s->skin_meshes[at], sizeof *s->skin_meshes * (s->skin_mesh_count - at));
+    s->skin_meshes[at] = (skin_mesh){mesh_id, count, jb};
+    s->skin_mesh_count++;
+    s->skinned_stale = true;
 }
 
 /* Sets one field. whole_checked: the caller checks the rules between fields on the whole object
@@ -209,11 +288,18 @@ static sy_result set_field(sy_scene *s, sy_object_type t, uint32_t id, uint32_t 
             sy_sc_mark_parents_bounds_dirty(s, id);
             break;
         case SY_NODE_CHILDREN: children_changed(s, id, old_children, d->children); break;
-        case SY_NODE_MESH: mesh_users_changed(s, id, old_mesh, d->mesh.id); break;
+        case SY_NODE_MESH:
+            mesh_users_changed(s, id, old_mesh, d->mesh.id);
+            if (d->skin) s->skinned_stale = true;
+            break;
+        case SY_NODE_SKIN: /* the joints place the mesh now (sy_scene_graph.c, skinned bounds) */
+            sy_sc_mark_bounds_dirty(s, id);
+            s->skinned_stale = true;
+            break;
         default: break;
         }
     } else if (t == SY_TYPE_MESH && field == SY_MESH_PRIMITIVES) {
-        mesh_bounds_update(s, sl);
+        mesh_bounds_update(s, id, sl);
     }
     sy_blob_release(old_children);
     return SY_OK;
@@ -256,6 +342,7 @@ sy_result sy_object_destroy(sy_scene *s, sy_object_type t, uint32_t id, sy_error
         if (ms) sy_sc_array_remove(ms->users, &ms->user_count, id);
     } else if (t == SY_TYPE_MESH) {
         for (uint32_t i = 0; i < sl->user_count; ++i) sy_sc_mark_bounds_dirty(s, sl->users[i]);
+        sy_sc_mesh_joint_bounds(s, id, NULL);
     }
     sy_sc_slot_release(sl, t);
     p->live--;
@@ -473,12 +560,6 @@ sy_result sy_node_set_skin(sy_scene *s, sy_node n, const sy_node *joints, const 
     sy_blob_release(b);
     if (r == SY_OK) r = sy_object_set_field(s, SY_TYPE_NODE, n.id, SY_NODE_SKELETON, &skeleton, err);
     return r;
-}
-
-const sy_skin_joint *sy_node_skin(const sy_node_data *d, uint32_t *count_out)
-{
-    *count_out = d && d->skin ? (uint32_t)(sy_blob_size(d->skin) / sizeof(sy_skin_joint)) : 0;
-    return *count_out ? (const sy_skin_joint *)sy_blob_data(d->skin) : NULL;
 }
 
 uint32_t sy_primitive_influences(const sy_primitive *p)

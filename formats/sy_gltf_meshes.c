@@ -107,7 +107,7 @@ static sy_result read_deform(loader *L, const sy_gltf_shim_primitive *pr, size_t
         else if (a->count != vcount || b->count != vcount) why = "JOINTS_n / WEIGHTS_n count differs from POSITION's";
         else if (a->component_type != CT_UBYTE && a->component_type != CT_USHORT) why = "JOINTS_n is not unsigned byte or short";
         else if ((a->buffer_view < 0 && !a->sparse) || (b->buffer_view < 0 && !b->sparse))
-            why = "JOINTS_n / WEIGHTS_n hold no data (a Draco primitive's skin attributes are not decoded)";
+            why = "JOINTS_n / WEIGHTS_n hold no data";
     }
     if (sets && !why) {
         size_t inf = 4 * sets, n;

@@ -672,7 +672,7 @@ static void fill_doc(sy_gltf_shim_impl *d)
 
 // >>KHR_draco_mesh_compression: each Draco primitive is decoded (sy_gltf_draco.cpp) into a new
 // buffer with one bufferView per accessor; its accessors are pointed at them (float attributes,
-// uint32 indices), so the loader reads them as plain accessors. The outputs are sized from the
+// uint16 joint indices, uint32 indices), so the loader reads them as plain accessors. The outputs are sized from the
 // glTF's accessor counts, within max_mesh_bytes for all primitives together, before decoding.
 static const uint8_t *data_at(const sy_gltf_shim_impl *d, const sy_gltf_shim_view &v)
 {
@@ -695,9 +695,11 @@ static sy_result draco_primitive(sy_gltf_shim_impl *d, size_t mi, size_t pj, con
         return sy_error_set(err, SY_ERR_PARSE, "indices accessor %d out of range", (int)pr.indices);
     const tinygltf::Value *attrs = member(ext, "attributes");
     if (!attrs || !attrs->IsObject()) return sy_error_set(err, SY_ERR_PARSE, "no attributes object");
-    // the attributes the loader reads; others (JOINTS, WEIGHTS) stay without data
+    // the attributes the loader reads (morph targets cannot be Draco-compressed: the extension keeps
+    // them in plain accessors)
     struct slot { const char *name; int32_t *acc; } slots[] = {{"POSITION", &pr.position}, {"NORMAL", &pr.normal},
-        {"TANGENT", &pr.tangent}, {"TEXCOORD_0", &pr.texcoord0}, {"TEXCOORD_1", &pr.texcoord1}, {"COLOR_0", &pr.color0}};
+        {"TANGENT", &pr.tangent}, {"TEXCOORD_0", &pr.texcoord0}, {"TEXCOORD_1", &pr.texcoord1}, {"COLOR_0", &pr.color0},
+        {"JOINTS_0", &pr.joints0}, {"WEIGHTS_0", &pr.weights0}, {"JOINTS_1", &pr.joints1}, {"WEIGHTS_1", &pr.weights1}};
     std::vector<sy_gltf_draco_attr> req_attrs;
     std::vector<int32_t *> req_acc;
     size_t vertices = 0;
@@ -758,8 +760,22 @@ static sy_result draco_primitive(sy_gltf_shim_impl *d, size_t mi, size_t pj, con
     point(&pr.indices, 0, indices * 4, 5125);
     off = indices * 4;
     for (size_t k = 0; k < req_attrs.size(); k++) {
-        point(req_acc[k], off, vertices * req_attrs[k].components * 4, 5126);
-        off += vertices * req_attrs[k].components * 4;
+        const size_t n = vertices * req_attrs[k].components;
+        if (std::strncmp(req_attrs[k].name, "JOINTS_", 7) == 0) { // joint indices as unsigned shorts, in place
+            const float *f = req_attrs[k].out;
+            uint16_t *u = reinterpret_cast<uint16_t *>(base + off); // u[i] overwrites only floats before f[i]
+            for (size_t i = 0; i < n; i++) {
+                const float j = f[i];
+                if (!(j >= 0.0f && j <= 65535.0f) || j != std::floor(j))
+                    return sy_error_set(err, SY_ERR_PARSE, "attribute %s: vertex %zu: joint index %g is not a whole number in 0..65535",
+                                        req_attrs[k].name, i / req_attrs[k].components, double(j));
+                u[i] = uint16_t(j);
+            }
+            point(req_acc[k], off, n * 2, 5123);
+        } else {
+            point(req_acc[k], off, n * 4, 5126);
+        }
+        off += n * 4;
     }
     return SY_OK;
 }

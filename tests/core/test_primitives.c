@@ -2,7 +2,8 @@
  * pairs for lines, any count for points, topology and width ranges), element / triangle counts,
  * the stroke width rule, mesh bounds grown by half the width, and the change-list round trip
  * (serialise, decode, apply to a replica, compare) of a line primitive with an explicit width; skin
- * attributes and morph targets refused when malformed. */
+ * attributes and morph targets refused when malformed; a skinned mesh's world bounds where its
+ * joints put its vertices. */
 #include "../support/sy_check.h"
 #include "../support/sy_scene_test.h"
 #include "wire_copy.h"
@@ -185,4 +186,92 @@ SY_SCENE_TEST(test_deform_validation)
     return 0;
 }
 
-SY_CHECK_MAIN("test_primitives", SY_TEST(test_validation), SY_TEST(test_round_trip), SY_TEST(test_deform_validation))
+/* World bounds of a skinned mesh follow its joints (sy_scene_graph.c, skinned bounds): a bar along x
+ * from 0 to 4, its right half on a joint at x = 2 that turns 90 degrees about z; the bounds are
+ * those of the vertices where the deformer puts them (sum_k w_k joint world x inverse bind), the
+ * skinned node's own placement (a parent moved by 5 in y) is ignored as glTF says, and moving the
+ * joints' root moves the bounds. Before: the bind pose's bounds at every pose. */
+static void skin_vertex(const sy_mat4 J[2], const float *w, const float *p, float out[3])
+{
+    for (int r = 0; r < 3; ++r)
+        out[r] = 0.0f;
+    for (int k = 0; k < 2; ++k)
+        for (int r = 0; r < 3; ++r)
+            out[r] += w[k] * (J[k].m[r] * p[0] + J[k].m[4 + r] * p[1] + J[k].m[8 + r] * p[2] + J[k].m[12 + r]);
+}
+
+SY_SCENE_TEST(test_skinned_bounds)
+{
+    enum { COLS = 5, NV = 2 * COLS };
+    float pos[3 * NV], wt[2 * NV];
+    uint32_t jn[2 * NV], idx[6 * (COLS - 1)];
+    for (int c = 0; c < COLS; ++c)
+        for (int r = 0; r < 2; ++r) {
+            int v = 2 * c + r;
+            pos[3 * v] = (float)c, pos[3 * v + 1] = 0.2f * (float)r, pos[3 * v + 2] = 0.0f;
+            jn[2 * v] = 0, jn[2 * v + 1] = 1;
+            wt[2 * v] = c < 2 ? 1.0f : c == 2 ? 0.5f : 0.0f; /* x < 2: joint 0; x = 2: both; x > 2: joint 1 */
+            wt[2 * v + 1] = 1.0f - wt[2 * v];
+        }
+    for (int c = 0; c + 1 < COLS; ++c) {
+        uint32_t a = (uint32_t)(2 * c), q[6] = {a, a + 2, a + 3, a, a + 3, a + 1};
+        memcpy(&idx[6 * c], q, sizeof q);
+    }
+    sy_blob *bp = sy_test_blob(pos, sizeof pos), *bj = sy_test_blob(jn, sizeof jn), *bw = sy_test_blob(wt, sizeof wt);
+    sy_blob *bi = sy_test_blob(idx, sizeof idx);
+    sy_primitive p = {.positions = bp, .indices = bi, .joints = bj, .weights = bw, .topology = SY_TOPOLOGY_TRIANGLES};
+    sy_mesh m;
+    sy_node root, group, skinned, j[2];
+    CHECK_OK(sy_mesh_create(s, "bar", &m, &e), e);
+    CHECK_OK(sy_mesh_set_primitives(s, m, &p, 1, &e), e);
+    CHECK_OK(sy_node_create(s, "root", &root, &e), e);
+    CHECK_OK(sy_node_create(s, "group", &group, &e), e);
+    CHECK_OK(sy_node_create(s, "skinned", &skinned, &e), e);
+    CHECK_OK(sy_node_create(s, "j0", &j[0], &e), e);
+    CHECK_OK(sy_node_create(s, "j1", &j[1], &e), e);
+    CHECK_OK(sy_node_add_child(s, root, group, &e), e);
+    CHECK_OK(sy_node_add_child(s, group, skinned, &e), e);
+    CHECK_OK(sy_node_add_child(s, root, j[0], &e), e);
+    CHECK_OK(sy_node_add_child(s, j[0], j[1], &e), e);
+    const float up5[3] = {0, 5, 0}, at2[3] = {2, 0, 0}, id_q[4] = {0, 0, 0, 1}, one[3] = {1, 1, 1};
+    CHECK_OK(sy_node_set_trs(s, group, up5, id_q, one, &e), e); /* ignored for the skinned mesh */
+    CHECK_OK(sy_node_set_trs(s, j[1], at2, id_q, one, &e), e);
+    CHECK_OK(sy_node_set_mesh(s, skinned, m, &e), e);
+    sy_mat4 ibm[2] = {sy_mat4_identity(), sy_mat4_identity()};
+    ibm[1].m[12] = -2.0f;
+    CHECK_OK(sy_node_set_skin(s, skinned, j, ibm, 2, j[0], &e), e);
+    const float h = 0.70710678f, turn[4] = {0, 0, h, h}, far[3] = {10, 0, 0};
+    for (int step = 0; step < 3; ++step) {
+        if (step == 1) CHECK_OK(sy_node_set_trs(s, j[1], at2, turn, one, &e), e);
+        if (step == 2) CHECK_OK(sy_node_set_trs(s, j[0], far, id_q, one, &e), e);
+        CHECK_OK(sy_scene_commit(s, NULL, &e), e);
+        sy_mat4 J[2];
+        for (int k = 0; k < 2; ++k) {
+            sy_mat4 w;
+            CHECK_OK(sy_node_world_matrix(s, j[k], &w, &e), e);
+            J[k] = sy_mat4_mul(&w, &ibm[k]);
+        }
+        sy_bounds want = sy_bounds_empty(), got, all;
+        for (int v = 0; v < NV; ++v) {
+            float q[3];
+            skin_vertex(J, &wt[2 * v], &pos[3 * v], q);
+            sy_bounds_add_point(&want, q);
+        }
+        CHECK_OK(sy_node_world_bounds(s, skinned, &got, &e), e);
+        CHECK_OK(sy_node_world_bounds(s, root, &all, &e), e);
+        for (int k = 0; k < 3; ++k) {
+            CHECK_MSG(fabsf(got.min[k] - want.min[k]) < 1e-4f && fabsf(got.max[k] - want.max[k]) < 1e-4f,
+                      "step %d axis %d: bounds [%g, %g], the deformed vertices [%g, %g]", step, k, got.min[k], got.max[k],
+                      want.min[k], want.max[k]);
+            CHECK_MSG(all.min[k] <= want.min[k] + 1e-4f && all.max[k] >= want.max[k] - 1e-4f,
+                      "step %d axis %d: the root's bounds [%g, %g] miss the deformed vertices [%g, %g]", step, k,
+                      all.min[k], all.max[k], want.min[k], want.max[k]);
+        }
+    }
+    sy_blob *blobs[] = {bp, bj, bw, bi};
+    for (size_t k = 0; k < sizeof blobs / sizeof blobs[0]; ++k) sy_blob_release(blobs[k]);
+    return 0;
+}
+
+SY_CHECK_MAIN("test_primitives", SY_TEST(test_validation), SY_TEST(test_round_trip), SY_TEST(test_deform_validation),
+              SY_TEST(test_skinned_bounds))
