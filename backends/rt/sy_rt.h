@@ -226,6 +226,19 @@ sy_rt_result sy_rt_mesh_destroy(sy_rt_device *dev, sy_rt_mesh mesh);
  * mesh's BLAS once that way (a tree of lower quality than the static meshes' HIGH); later updates
  * refit. Instances of the mesh see the new shape at the next sy_rt_commit. */
 sy_rt_result sy_rt_mesh_update(sy_rt_device *dev, sy_rt_mesh mesh, const float *positions, const float *normals);
+/** A mesh's vertices as the device holds them (sy_rt_mesh_get_view). Borrowed from the device: the
+ * arrays stay readable until the mesh is next updated (sy_rt_mesh_update and its motion variants
+ * rewrite positions in place) or destroyed; they must not be written. */
+typedef struct sy_rt_mesh_view {
+    const float *positions;  /**< float3 x vertex_count: its pose at ray time 0 (a shared mesh's are the caller's array) */
+    const uint32_t *indices; /**< 3 x triangle_count (those of a non-indexed mesh are 0, 1, 2, ...) */
+    uint32_t vertex_count;   /**< vertices */
+    uint32_t triangle_count; /**< triangles */
+} sy_rt_mesh_view;
+/** Fills *out with mesh's vertices and indices (a stale handle: SY_RT_ERROR_INVALID_HANDLE, *out
+ * zeroed). O(1), no copy: temporal reuse keeps a deforming mesh's previous pose from it before an
+ * update (mediators/rt, object motion). */
+sy_rt_result sy_rt_mesh_get_view(const sy_rt_device *dev, sy_rt_mesh mesh, sy_rt_mesh_view *out);
 
 /* >>texture */
 
@@ -395,6 +408,9 @@ sy_rt_result sy_rt_instance_set_visible(sy_rt_device *dev, sy_rt_instance inst, 
 sy_rt_result sy_rt_instance_destroy(sy_rt_device *dev, sy_rt_instance inst);
 /** The instance's transform (time 0) as last set. */
 sy_rt_result sy_rt_instance_get_transform(const sy_rt_device *dev, sy_rt_instance inst, float transform[16]);
+/** The mesh handle the instance was created with (its data lives while the instance does; the
+ * handle itself may be stale once sy_rt_mesh_destroy was called on it). */
+sy_rt_result sy_rt_instance_get_mesh(const sy_rt_device *dev, sy_rt_instance inst, sy_rt_mesh *mesh);
 
 /* >>motion blur: each ray has a time in [0, 1): 0 the shutter's open, 1 its close. An instance with
  * motion is placed by its transform at time 0 and by `close` at time 1, the matrix interpolated
@@ -783,6 +799,19 @@ void sy_rt_pt_record_bsdf_batch(const sy_rt_pt_record *record, uint32_t count, c
 /** Fills ids (and depth, if not NULL) with the nearest visible instance per pixel centre. */
 sy_rt_result sy_rt_coverage(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc,
                             uint32_t *ids, float *depth);
+/** One pixel of sy_rt_coverage_hits. Plain data. */
+typedef struct sy_rt_coverage_hit {
+    uint32_t instance; /**< handle id of the nearest visible instance hit; 0: nothing */
+    uint32_t triangle; /**< the hit triangle's index in the instance's mesh (0 on a miss) */
+    /** @{ Embree's barycentrics: weights of the triangle's vertices 1 and 2 (0 on a miss) */
+    float u, v; /** @} */
+} sy_rt_coverage_hit;
+/** As sy_rt_coverage, the same rays, with the hit triangle and its barycentrics per pixel (what
+ * sy_rt_pick answers for one pixel, for every pixel of the rectangle): temporal reuse follows
+ * deforming meshes with them (the hit point at the mesh's previous pose). hits: width * height of the
+ * desc's rectangle. */
+sy_rt_result sy_rt_coverage_hits(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc,
+                                  sy_rt_coverage_hit *hits);
 
 /* >>pick
  *

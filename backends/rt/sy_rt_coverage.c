@@ -1,5 +1,6 @@
-/* sy_rt_coverage.c — per-pixel object ids for culling services and the pick of one pixel (see
- * sy_rt.h, >>coverage and >>pick). */
+/* sy_rt_coverage.c — per-pixel object ids for culling services (with the hit triangle and its
+ * barycentrics for temporal reuse's deforming meshes) and the pick of one pixel (see sy_rt.h,
+ * >>coverage and >>pick). */
 #include "sy_rt_coverage.h"
 
 #include <math.h>
@@ -19,6 +20,38 @@ static void coverage_hit(const sy_rt_frame *f, void *user, size_t o, const struc
 void sy_rt_coverage_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1)
 {
     sy_rt_frame_tile_hits(f, x0, y0, x1, y1, coverage_hit, user);
+}
+
+/* sy_rt_coverage_hits: the instance, triangle and barycentrics of each pixel's hit */
+static void coverage_full_hit(const sy_rt_frame *f, void *user, size_t o, const struct RTCRayHit *rh, float axial)
+{
+    (void)axial;
+    const sy_rt_instance_data *in = rh->hit.geomID == RTC_INVALID_GEOMETRY_ID
+                                        ? NULL
+                                        : sy_rt_hit_instance(f->dev, rh->hit.geomID, rh->hit.instID[0]);
+    sy_rt_coverage_hit *h = (sy_rt_coverage_hit *)user + o;
+    if (in && rh->hit.primID < in->mesh->triangle_count) *h = (sy_rt_coverage_hit){in->handle, rh->hit.primID, rh->hit.u, rh->hit.v};
+    else *h = (sy_rt_coverage_hit){0, 0, 0.0f, 0.0f};
+}
+
+static void coverage_hits_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1)
+{
+    sy_rt_frame_tile_hits(f, x0, y0, x1, y1, coverage_full_hit, user);
+}
+
+sy_rt_result sy_rt_coverage_hits(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc,
+                                  sy_rt_coverage_hit *hits)
+{
+    if (dev && camera) sy_rt_clip_begin(dev, camera);
+    if (!dev || !camera || !desc || !hits) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "coverage hits: NULL argument");
+    if (dev->dirty)
+        return FAIL(SY_RT_ERROR_INVALID_OPERATION, "coverage hits: the device has uncommitted changes; call sy_rt_commit first");
+    sy_rt_render_desc d = *desc;
+    d.integrator = SY_RT_INTEGRATOR_COVERAGE;
+    sy_rt_frame f;
+    sy_rt_result r = sy_rt_frame_init(&f, dev, camera, &d, NULL, NULL);
+    if (r != SY_RT_OK) return r;
+    return sy_rt_run_tiles(&f, coverage_hits_tile, hits, desc->progress, desc->progress_user_data);
 }
 
 sy_rt_result sy_rt_coverage(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc,

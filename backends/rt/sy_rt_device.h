@@ -74,6 +74,7 @@ typedef struct sy_rt_instance_data {
     float *baked_positions;    /* baked: Embree vertex buffer (world space) */
     bool filter_on;            /* baked: alpha filter installed */
     uint32_t handle;           /* this instance's own handle id (coverage output) */
+    uint32_t mesh_handle;      /* the handle id of the mesh it was made with (sy_rt_instance_get_mesh) */
     /* Moves without rebuilding the top-level BVH (sy_rt_moved.c): */
     bool xf_pending;           /* geom in the top scene still holds an older transform (in dev->pending) */
     bool stale;                /* the top scene's copy is filtered out; `twin` in dev->dyn shows the instance */

@@ -51,6 +51,7 @@ sy_rt_result sy_rt_instance_create(sy_rt_device *dev, const sy_rt_instance_desc 
     sy_rt_instance_data *in = calloc(1, sizeof *in);
     if (!in) return FAIL(SY_RT_ERROR_OUT_OF_MEMORY, "instance: out of memory");
     in->mesh = mesh;
+    in->mesh_handle = d->mesh.id;
     mesh->refs++;
     in->material = d->material;
     in->flags = flags;

@@ -247,6 +247,16 @@ sy_rt_result sy_rt_mesh_update(sy_rt_device *dev, sy_rt_mesh mesh, const float *
     return sy_rt_check_embree(dev, "mesh update");
 }
 
+sy_rt_result sy_rt_mesh_get_view(const sy_rt_device *dev, sy_rt_mesh mesh, sy_rt_mesh_view *out)
+{
+    if (!dev || !out) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "mesh get_view: NULL argument");
+    memset(out, 0, sizeof *out);
+    const sy_rt_mesh_data *m = sy_rt_pool_get(&dev->meshes, mesh.id);
+    if (!m) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "mesh get_view: mesh handle 0x%08x is stale", mesh.id);
+    *out = (sy_rt_mesh_view){m->positions, m->indices, m->vertex_count, m->triangle_count};
+    return SY_RT_OK;
+}
+
 /* The mesh's BLAS, built on first use by an Embree instance (a mesh used only by baked instances
  * never needs one). Large meshes build with a compact layout and medium quality: a high-quality
  * build (spatial splits) of 10^7 triangles needs several times the memory of the finished BVH. */

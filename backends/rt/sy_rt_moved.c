@@ -236,6 +236,15 @@ sy_rt_result sy_rt_instance_get_transform(const sy_rt_device *dev, sy_rt_instanc
     return SY_RT_OK;
 }
 
+sy_rt_result sy_rt_instance_get_mesh(const sy_rt_device *dev, sy_rt_instance inst, sy_rt_mesh *mesh)
+{
+    if (!dev || !mesh) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "instance get_mesh: NULL argument");
+    const sy_rt_instance_data *in = sy_rt_pool_get(&dev->instances, inst.id);
+    if (!in) return FAIL(SY_RT_ERROR_INVALID_HANDLE, "instance get_mesh: stale handle 0x%08x", inst.id);
+    mesh->id = in->mesh_handle;
+    return SY_RT_OK;
+}
+
 sy_rt_result sy_rt_instance_set_motion(sy_rt_device *dev, sy_rt_instance inst, const float close[16])
 {
     return sy_rt_instance_set_motion_steps(dev, inst, 2u, close);

@@ -3,7 +3,9 @@
  * ray with the two axis-aligned quads analytically (nearer quad wins). The pick of one pixel
  * (sy_rt_pick) names the same instance at every pixel, with the coverage depth, and a triangle,
  * barycentrics, vertices and transform that put the hit on the pixel-centre ray; bad pixels and
- * uncommitted devices are refused. */
+ * uncommitted devices are refused. sy_rt_coverage_hits gives every pixel the pick's instance,
+ * triangle and barycentrics bit for bit; sy_rt_mesh_get_view and sy_rt_instance_get_mesh give
+ * the vertices the pick read, and after sy_rt_mesh_update the new ones. */
 #include "rt_test.h"
 
 #define W 100
@@ -80,6 +82,50 @@ int main(void)
     EXPECT_MSG(sy_rt_pick(dev, &cam, W, H, W, 0, &ph) == SY_RT_ERROR_INVALID_ARGUMENT && ph.instance.id == 0 &&
                    strstr(rt_test_msg, "(100, 0)"),
                "pick outside the image: %s", rt_test_msg);
+
+    /* sy_rt_coverage_hits: the pick's instance, triangle and barycentrics at every pixel; the
+     * instance's mesh and that mesh's view give the vertices the pick read */
+    static sy_rt_coverage_hit hits[W * H];
+    MUST(sy_rt_coverage_hits(dev, &cam, &d, hits));
+    int hit_wrong = 0, view_wrong = 0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            const sy_rt_coverage_hit *h = &hits[y * W + x];
+            MUST(sy_rt_pick(dev, &cam, W, H, (uint32_t)x, (uint32_t)y, &ph));
+            hit_wrong += h->instance != ph.instance.id || h->instance != ids[y * W + x];
+            if (!h->instance) {
+                hit_wrong += h->triangle != 0 || h->u != 0.0f || h->v != 0.0f;
+                continue;
+            }
+            hit_wrong += h->triangle != ph.triangle || h->u != ph.u || h->v != ph.v;
+            sy_rt_mesh mesh;
+            sy_rt_mesh_view mv;
+            MUST(sy_rt_instance_get_mesh(dev, ph.instance, &mesh));
+            MUST(sy_rt_mesh_get_view(dev, mesh, &mv));
+            view_wrong += mesh.id != (h->instance == far_q.id ? big.id : small.id) || h->triangle >= mv.triangle_count;
+            for (int k = 0; k < 3 && h->triangle < mv.triangle_count; ++k)
+                view_wrong += memcmp(mv.positions + 3u * mv.indices[3u * h->triangle + k], ph.vertices[k], 3 * sizeof(float)) != 0;
+        }
+    EXPECT_MSG(hit_wrong == 0, "%d coverage hits differ from the picks", hit_wrong);
+    EXPECT_MSG(view_wrong == 0, "%d pixels whose mesh view differs from the pick's vertices", view_wrong);
+    {
+        sy_rt_mesh_view mv;
+        MUST(sy_rt_mesh_get_view(dev, big, &mv));
+        const float nrm[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}; /* rt_quad's */
+        float moved[12];
+        for (uint32_t i = 0; i < mv.vertex_count * 3u && i < 12u; ++i) moved[i] = mv.positions[i] * 1.5f;
+        EXPECT(mv.vertex_count == 4 && mv.triangle_count == 2);
+        MUST(sy_rt_mesh_update(dev, big, moved, nrm));
+        MUST(sy_rt_mesh_get_view(dev, big, &mv));
+        EXPECT_MSG(!memcmp(mv.positions, moved, sizeof moved), "the view after an update is not the update's vertices");
+        for (uint32_t i = 0; i < 12u; ++i) moved[i] /= 1.5f;
+        MUST(sy_rt_mesh_update(dev, big, moved, nrm));
+        MUST(sy_rt_commit(dev));
+        sy_rt_mesh none;
+        EXPECT(sy_rt_mesh_get_view(dev, (sy_rt_mesh){0}, &mv) == SY_RT_ERROR_INVALID_HANDLE && mv.positions == NULL);
+        EXPECT(sy_rt_instance_get_mesh(dev, (sy_rt_instance){0}, &none) == SY_RT_ERROR_INVALID_HANDLE);
+        EXPECT(sy_rt_coverage_hits(dev, &cam, &d, NULL) == SY_RT_ERROR_INVALID_ARGUMENT);
+    }
 
     /* a sub-rectangle equals the crop of the full image */
     sy_rt_render_desc sub = d;
