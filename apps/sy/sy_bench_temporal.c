@@ -8,7 +8,10 @@
  * 1 % + 0.002) and the ratio, the change of the display when the camera stops at the path's end
  * (sy_filter_temporal_rest: no pop), and the cost of the temporal stage per frame at 640x360 next to
  * one 1-spp pass there, and the cost of the object motion pass (every instance sliding under a still
- * camera) next to the rest of the stage. Ratios come from one run; nothing here is a timed test. */
+ * camera) next to the rest of the stage, and for a scene with an animation (skins, morph targets)
+ * the pass with per-vertex motion while it plays, next to the rest and to the rigid pass. Ratios
+ * come from one run; nothing here is a timed test. */
+#include "sy_anim.h"
 #include "sy_bench.h"
 #include "sy_interactive.h"
 #include "sy_png.h"
@@ -277,7 +280,7 @@ sy_result sy_bench_temporal(sy_scene *scene, const sy_viewport_desc *vd, const c
     sy_mat4 *saved = nkids ? malloc(nkids * sizeof *saved) : NULL;
     if (r == SY_OK && nkids && !saved) r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "bench temporal: out of memory");
     for (uint32_t i = 0; saved && i < nkids; ++i) saved[i] = sy_node_get(scene, (sy_node){kids[i]})->transform.matrix;
-    double om[12], os[12];
+    double om[12] = {0}, os[12] = {0}, ot[12] = {0};
     uint64_t moving = 0;
     for (uint32_t k = 0; k < 13 && r == SY_OK && saved; ++k) {
         for (uint32_t i = 0; i < nkids && r == SY_OK; ++i) {
@@ -293,6 +296,7 @@ sy_result sy_bench_temporal(sy_scene *scene, const sy_viewport_desc *vd, const c
         if (r == SY_OK && k > 0) {
             sy_mediator_rt_filter_info_get(sy_context_state(ctx), &fi);
             om[k - 1] = fi.temporal_motion_seconds, os[k - 1] = fi.temporal_seconds - fi.temporal_motion_seconds;
+            ot[k - 1] = fi.temporal_motion_seconds - fi.temporal_motion_trace_seconds;
             moving = fi.temporal_moving_pixels;
         }
     }
@@ -302,14 +306,49 @@ sy_result sy_bench_temporal(sy_scene *scene, const sy_viewport_desc *vd, const c
         if (r == SY_OK) {
             qsort(om, 12, sizeof om[0], sy_bench_cmp_double);
             qsort(os, 12, sizeof os[0], sy_bench_cmp_double);
+            qsort(ot, 12, sizeof ot[0], sy_bench_cmp_double);
             printf("  object motion at 640x360 (still camera, every instance sliding): motion pass %.2f ms per frame "
-                   "(median of 12; coverage rays + per-pixel motion), the rest of the temporal stage %.1f ms: %.2fx; "
-                   "%llu moving pixels\n",
-                   om[6] * 1e3, os[6] * 1e3, om[6] / os[6], (unsigned long long)moving);
+                   "(median of 12; coverage rays + per-pixel motion, of it the per-pixel motion %.2f ms), the rest of "
+                   "the temporal stage %.1f ms: %.2fx; %llu moving pixels\n",
+                   om[6] * 1e3, ot[6] * 1e3, os[6] * 1e3, om[6] / os[6], (unsigned long long)moving);
         }
         free(saved);
     }
     free(kids);
+    /* deforming meshes at 640x360: a scene with an animation plays it (every clip, 1/24 s per frame)
+     * under the still camera, 12 frames: the object motion pass with per-vertex motion (coverage
+     * rays with triangles and barycentrics + the hit at the earlier pose) against the rest of the
+     * stage and against the rigid pass above (same run, same view) */
+    double dm[12], ds[12], dt[12];
+    uint64_t dpx = 0, dmov = 0;
+    bool animated = false;
+    for (uint32_t k = 0; k < 13 && r == SY_OK; ++k) {
+        sy_anim_stats as = {0};
+        r = sy_scene_set_time_ex(scene, (sy_animation){0}, (double)k / 24.0, &as, err);
+        if (r != SY_OK || (k == 0 && as.channels == 0 && as.weights == 0)) break;
+        animated = true;
+        r = sy_scene_commit(scene, NULL, err);
+        sy_mat4 m;
+        path_view(&home, 0, &m);
+        double s;
+        if (r == SY_OK) r = bench_win_frame(&cost, &m, scene, pool, 1, 0, &a, &s, err);
+        if (r == SY_OK && k > 0) {
+            sy_mediator_rt_filter_info_get(sy_context_state(ctx), &fi);
+            dm[k - 1] = fi.temporal_motion_seconds, ds[k - 1] = fi.temporal_seconds - fi.temporal_motion_seconds;
+            dt[k - 1] = fi.temporal_motion_seconds - fi.temporal_motion_trace_seconds;
+            dpx = fi.temporal_deformed_pixels, dmov = fi.temporal_moving_pixels;
+        }
+    }
+    if (r == SY_OK && animated) {
+        qsort(dm, 12, sizeof dm[0], sy_bench_cmp_double);
+        qsort(ds, 12, sizeof ds[0], sy_bench_cmp_double);
+        qsort(dt, 12, sizeof dt[0], sy_bench_cmp_double);
+        printf("  animation at 640x360 (still camera, every clip at 24 fps): motion pass %.2f ms per frame (median of "
+               "12; per-vertex motion on %llu deformed pixels of %llu moving; of it the per-pixel motion %.2f ms), the "
+               "rest of the temporal stage %.1f ms: %.2fx; the rigid pass above %.2f ms: %.2fx of it\n",
+               dm[6] * 1e3, (unsigned long long)dpx, (unsigned long long)dmov, dt[6] * 1e3, ds[6] * 1e3, dm[6] / ds[6],
+               om[6] * 1e3, om[6] > 0 ? dm[6] / om[6] : 0.0);
+    }
     for (int q = 0; q <= SERIES; ++q) free(prev[q]), sy_layer_destroy(&img[q]);
     sy_layer_destroy(&a);
     sy_context_pool_destroy(pool);

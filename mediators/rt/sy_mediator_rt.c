@@ -67,6 +67,7 @@ static sy_result rt_create_common(const sy_mediator_create_args *args, uint32_t 
     st->inst_sel = SY_MIRROR_MAP_INIT(uint8_t);
     st->inst_place = SY_MIRROR_MAP_INIT(uint32_t);
     st->temporal_from = SY_MIRROR_MAP_INIT(rt_move_rec);
+    st->temporal_deform = SY_MIRROR_MAP_INIT(rt_deform_rec);
     sy_rt_device_desc dd = sy_rti_device_desc(st, (uint32_t)threads, (uint64_t)max_memory_mb << 20);
     sy_rt_result rr = sy_rt_device_create(&dd, &st->dev);
     if (rr != SY_RT_OK) {

@@ -118,9 +118,15 @@ uint32_t sy_mediator_rt_aov_channels(uint32_t index);  /**< 4, 3, 3, 3, 1, 3, 3 
  *   only instance transforms (or visibility, or deformed vertices) since the previous render makes
  *   that render a moving frame under a still camera too (instead of restarting the history), and
  *   every moving frame gives the filter per-pixel object motion (the instance under each pixel
- *   centre, sy_rt_coverage, and M_prev M_now^-1 p - p at its world position p; deformed meshes and
- *   unmoved instances 0). 0: the camera's motion alone, as before (the baseline of
+ *   centre, sy_rt_coverage, and M_prev M_now^-1 p - p at its world position p; unmoved instances
+ *   0). 0: the camera's motion alone, as before (the baseline of
  *   tests/integration/test_pathtracer_motion.c).
+ *   temporal_deform=0|1 (default 1): with temporal_motion, deformed (skinned, morphed) meshes too:
+ *   their pose at the previous render is kept (a copy of the device's vertices before their first
+ *   update since, only for meshes that deform), and a pixel whose first hit is on one gets the
+ *   hit's motion from it (sy_rt_coverage_hits: its triangle and barycentrics; M_prev x_prev - M_now
+ *   x_now). 0: their pixels get no motion, as before (the baseline of
+ *   tests/integration/test_pathtracer_deform.c).
  * sy_mediator_rt_set_filter changes it live: name (NULL = opts' "filter" or unchanged) and the keys
  * present in opts (NULL = none; absent keys keep their values). Only the threshold keeps the pixel
  * filter's filtered buffer; any other change recomputes it at the next frame. On error nothing
@@ -151,7 +157,10 @@ typedef struct sy_mediator_rt_filter_info {
                                      with the last estimate (sy_filter_temporal_rest) */
     double temporal_motion_seconds;  /**< the last render: wall time of its object motion (coverage rays + the
                                           per-pixel motion), 0 when no instance moved */
+    double temporal_motion_trace_seconds; /**< of it: the coverage rays (sy_rt_coverage, or sy_rt_coverage_hits
+                                               when some mesh deformed); the rest is the per-pixel motion */
     uint64_t temporal_moving_pixels; /**< the last render: pixels given a non-zero object motion */
+    uint64_t temporal_deformed_pixels; /**< of them: pixels of deformed meshes given per-vertex motion (temporal_deform) */
 } sy_mediator_rt_filter_info;
 /** Fills *out with the context's filter state. */
 void sy_mediator_rt_filter_info_get(void *state, sy_mediator_rt_filter_info *out);

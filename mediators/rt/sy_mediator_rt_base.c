@@ -78,6 +78,10 @@ const sy_param_decl sy_rti_pathtracer_params[] = {
      "temporal reuse: follow moving instances (per-pixel object motion from their transforms at the last "
      "render; 0 = camera motion only, the comparison's baseline); with it, a still camera whose scene changed "
      "only by moves also reuses the history", LIVE},
+    {"temporal_deform", SY_PARAM_BOOL, 0, 0, "1", NULL,
+     "temporal reuse: follow deforming (skinned, morphed) meshes too (per-vertex motion: the hit point at the "
+     "mesh's pose of the last render; 0 = their pixels get no object motion, the comparison's baseline); "
+     "with temporal_motion=1", LIVE},
 };
 #undef LIVE
 const sy_param_table sy_rti_whitted_table = SY_PARAM_TABLE(sy_rti_whitted_params);

@@ -17,7 +17,7 @@ static const char *const pt_filter_names[PT_FILTER_KIND_COUNT] = {"none", "pixel
  * feature buffers. Parameters (creation and sy_mediator_rt_set_filter): filter, threshold, sigma_s,
  * sigma_c, sigma_d, filter_kernel, filter_iterations, filter_start, atrous_iterations, jbu_factor,
  * temporal (temporal reuse on frames whose camera moved: sy_rti_temporal_layer below), temporal_motion
- * (and on frames whose instances moved, following them). */
+ * (and on frames whose instances moved, following them), temporal_deform (and deforming meshes). */
 /* Every code a filter returns has core's number (the cast in sy_backend_fail). */
 SY_BACKEND_SAME_CODE(SY_FILTER_ERROR_INVALID_ARGUMENT, SY_ERR_INVALID_ARGUMENT);
 SY_BACKEND_SAME_CODE(SY_FILTER_ERROR_OUT_OF_MEMORY, SY_ERR_OUT_OF_MEMORY);
@@ -32,6 +32,7 @@ void sy_rti_filter_cfg_default(pt_filter_cfg *c, uint32_t threads)
     memset(c, 0, sizeof *c);
     c->kind = PT_FILTER_NONE;
     c->temporal_motion = true;
+    c->temporal_deform = true;
     sy_filter_pixel_params_default(&c->pixel);
     sy_filter_atrous_params_default(&c->atrous);
     sy_filter_jbu_params_default(&c->jbu);
@@ -121,7 +122,8 @@ sy_result sy_rti_filter_cfg_apply(pt_filter_cfg *base, const char *name, const s
         (r = pt_u32(p, all, "atrous_iterations", &c.atrous.iterations, err)) ||
         (r = pt_u32(p, all, "jbu_factor", &c.jbu.factor, err)) || (r = radiance_cfg_apply(&c.radiance, p, all, err)) ||
         (r = pt_bool(p, all, "temporal", &c.temporal, err)) ||
-        (r = pt_bool(p, all, "temporal_motion", &c.temporal_motion, err)))
+        (r = pt_bool(p, all, "temporal_motion", &c.temporal_motion, err)) ||
+        (r = pt_bool(p, all, "temporal_deform", &c.temporal_deform, err)))
         return r;
     c.pixel.threshold = c.adaptive.threshold = c.radiance.threshold = threshold;
     c.pixel.kernel = fkernel ? SY_FILTER_PIXEL_BRUTE : SY_FILTER_PIXEL_SEPARABLE;
@@ -136,6 +138,68 @@ sy_result sy_rti_filter_cfg_apply(pt_filter_cfg *base, const char *name, const s
         return filter_fail(err, &fe);
     *base = c;
     return SY_OK;
+}
+
+/* Frees the deforming meshes' earlier poses (temporal reuse's per-vertex motion). */
+static void deform_free(rt_state *st)
+{
+    for (uint32_t i = 0; i < st->temporal_deform.cap; ++i) {
+        rt_deform_rec *d = sy_mirror_map_slot(&st->temporal_deform, i);
+        if (d) free(d->prev);
+    }
+    sy_mirror_map_free(&st->temporal_deform);
+    st->temporal_fresh = 0;
+}
+
+/* >>per-vertex motion
+ * Before a deforming mesh's vertices are rewritten (cb_primitive_update), its pose at the last
+ * render is copied from the device, once per render: on its first update since (while temporal,
+ * temporal_motion and temporal_deform are on). Memory only for meshes that deform: a record not
+ * refreshed over a render is freed at the end of the next (sy_rti_temporal_layer), and a record
+ * keeps its buffer from one render to the next while its mesh deforms. Out of memory: the change
+ * counts as one that is not a move (the history restarts under a still camera). */
+void sy_rti_temporal_deform_record(rt_state *st, uint32_t mesh)
+{
+    if (!st->filter.temporal || !st->filter.temporal_motion || !st->filter.temporal_deform) return;
+    rt_deform_rec *d = sy_mirror_map_get(&st->temporal_deform, mesh);
+    if (d && d->fresh) return; /* deformed again since the last render: its pose then is kept */
+    sy_rt_mesh_view v;
+    if (sy_rt_mesh_get_view(st->dev, (sy_rt_mesh){mesh}, &v) != SY_RT_OK || !v.positions) return;
+    if (!d && !(d = sy_mirror_map_put(&st->temporal_deform, mesh))) {
+        st->sync_other = true;
+        return;
+    }
+    if (d->vertex_count != v.vertex_count || !d->prev) {
+        free(d->prev);
+        d->vertex_count = v.vertex_count;
+        if (!(d->prev = malloc((size_t)v.vertex_count * 3u * sizeof(float) + 1u))) {
+            sy_mirror_map_del(&st->temporal_deform, mesh);
+            st->sync_other = true;
+            return;
+        }
+    }
+    memcpy(d->prev, v.positions, (size_t)v.vertex_count * 3u * sizeof(float));
+    d->fresh = true;
+    st->temporal_fresh++;
+}
+
+/* After a render: records not refreshed since the render before go (their meshes stopped
+ * deforming); the fresh ones become stale, their buffers kept for the next copy. */
+static void deform_age(rt_state *st)
+{
+    if (!st->temporal_deform.live) return;
+    for (uint32_t i = 0; i < st->temporal_deform.cap; ++i) {
+        rt_deform_rec *d = sy_mirror_map_slot(&st->temporal_deform, i);
+        if (!d) continue;
+        if (d->fresh) {
+            d->fresh = false;
+            continue;
+        }
+        free(d->prev);
+        sy_mirror_map_del(&st->temporal_deform, st->temporal_deform.keys[i]);
+    }
+    st->temporal_fresh = 0;
+    if (!st->temporal_deform.live) sy_mirror_map_free(&st->temporal_deform);
 }
 
 sy_result sy_mediator_rt_set_filter(void *state, const char *name, const sy_params *opts, sy_error *err)
@@ -176,6 +240,7 @@ sy_result sy_mediator_rt_set_filter(void *state, const char *name, const sy_para
         st->temporal_have_cam = false;
         sy_mirror_map_free(&st->temporal_from); /* and no moves are recorded while it is off */
     }
+    if (!c.temporal || !c.temporal_motion || !c.temporal_deform) deform_free(st); /* nor earlier poses */
     st->filter = c;
     return SY_OK;
 }
@@ -356,15 +421,66 @@ bool sy_rti_temporal_moving(const rt_state *st, const sy_render_request *req)
  * instance each pixel centre's camera ray hits (sy_rt_coverage: one ray per pixel, the ray of the ID
  * AOVs), and for an instance moved since the last render (st->temporal_from, recorded by the sync)
  * motion = M_prev M_now^-1 p - p at the pixel's world position p (the filter's, from the mean
- * depth). Instances not moved, misses and deformed meshes (vertices moved under a still transform)
- * get 0: their history is rejected where the surface left the depth or normal tolerance, or
- * clamped. An instance whose matrix cannot be inverted gets NaN (no history). *any false (no
- * motion plane: the camera's motion alone) when no instance moved; *pixels counts the pixels that moved. */
-static sy_result object_motion(rt_state *st, const sy_render_request *req, const float *pos, bool *any,
-                               uint64_t *pixels, sy_error *err)
+ * depth). A deformed (skinned, morphed) mesh's pixels (temporal_deform; its pose at the last render
+ * in st->temporal_deform, >>per-vertex motion above): the same rays give the triangle and its
+ * barycentrics (sy_rt_coverage_hits, only for renders with such meshes: the rigid case keeps the
+ * cheaper ids), and motion = M_prev x_prev - M_now x_now, x_prev and x_now the hit's barycentric
+ * point on the triangle's earlier and present vertices (M_prev = M_now when the instance did not
+ * move). Instances neither moved nor deformed, and misses, get 0; with temporal_deform=0 deformed
+ * meshes get 0 too (their history rejected where the surface left the depth or normal tolerance,
+ * clamped elsewhere). An instance whose matrix cannot be inverted gets NaN (no history) at its
+ * rigidly moved pixels. *any false (no motion plane: the camera's motion alone) when nothing moved;
+ * *pixels counts the pixels that moved, *deformed those of them given per-vertex motion. */
+typedef struct motion_run { /* what the pixels of one instance share (looked up when the id changes) */
+    const rt_move_rec *mr;     /* moved since the last render, or NULL */
+    const rt_deform_rec *dr;   /* its mesh deformed since the last render, or NULL */
+    sy_rt_mesh_view now;       /* dr: the mesh's present vertices */
+    float xf[16], prev[16];    /* dr: its matrix now and at the last render */
+} motion_run;
+
+static void motion_run_get(rt_state *st, uint32_t id, bool deform, motion_run *run)
 {
-    *any = false, *pixels = 0;
-    if (!st->filter.temporal_motion || !st->temporal_from.live) return SY_OK;
+    run->dr = NULL;
+    rt_move_rec *r = id ? sy_mirror_map_get(&st->temporal_from, id) : NULL;
+    if (r && !r->ready) { /* to_prev = prev now^-1, NaN when now has no inverse */
+        sy_mat4 now, inv, prev, tp;
+        r->ready = true;
+        if (sy_rt_instance_get_transform(st->dev, (sy_rt_instance){id}, now.m) == SY_RT_OK && sy_mat4_invert(&now, &inv)) {
+            memcpy(prev.m, r->prev, sizeof prev.m);
+            tp = sy_mat4_mul(&prev, &inv);
+            memcpy(r->to_prev, tp.m, sizeof tp.m);
+        } else {
+            for (int k = 0; k < 16; ++k) r->to_prev[k] = NAN;
+        }
+    }
+    run->mr = r;
+    sy_rt_mesh mesh;
+    if (!deform || !id || sy_rt_instance_get_mesh(st->dev, (sy_rt_instance){id}, &mesh) != SY_RT_OK) return;
+    const rt_deform_rec *d = sy_mirror_map_get(&st->temporal_deform, mesh.id);
+    if (!d || !d->fresh || sy_rt_mesh_get_view(st->dev, mesh, &run->now) != SY_RT_OK ||
+        run->now.vertex_count != d->vertex_count ||
+        sy_rt_instance_get_transform(st->dev, (sy_rt_instance){id}, run->xf) != SY_RT_OK)
+        return;
+    if (r) memcpy(run->prev, r->prev, sizeof run->prev);
+    else memcpy(run->prev, run->xf, sizeof run->prev);
+    run->dr = d;
+}
+
+/* x = M (b0 p[i0] + u p[i1] + v p[i2]) */
+static inline void bary_point(const float *m, const float *p, const uint32_t *ix, float u, float v, float x[3])
+{
+    float b0 = 1.0f - u - v, o[3];
+    const float *a = p + 3u * ix[0], *b = p + 3u * ix[1], *c = p + 3u * ix[2];
+    for (int k = 0; k < 3; ++k) o[k] = b0 * a[k] + u * b[k] + v * c[k];
+    for (int k = 0; k < 3; ++k) x[k] = m[k] * o[0] + m[4 + k] * o[1] + m[8 + k] * o[2] + m[12 + k];
+}
+
+static sy_result object_motion(rt_state *st, const sy_render_request *req, const float *pos, bool *any,
+                               uint64_t *pixels, uint64_t *deformed, sy_error *err)
+{
+    *any = false, *pixels = 0, *deformed = 0;
+    bool deform = st->filter.temporal_deform && st->temporal_fresh > 0;
+    if (!st->filter.temporal_motion || (!st->temporal_from.live && !deform)) return SY_OK;
     size_t n = (size_t)req->rect_w * req->rect_h;
     if (n > st->motion_px) {
         free(st->motion_ids), free(st->motion_buf);
@@ -375,39 +491,53 @@ static sy_result object_motion(rt_state *st, const sy_render_request *req, const
             return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "pathtracer temporal: out of memory for the motion of %ux%u",
                                 req->rect_w, req->rect_h);
     }
+    if (deform && n > st->motion_hits_px) {
+        free(st->motion_hits);
+        st->motion_hits = malloc(n * sizeof *st->motion_hits);
+        st->motion_hits_px = st->motion_hits ? n : 0;
+        if (!st->motion_hits)
+            return sy_error_set(err, SY_ERR_OUT_OF_MEMORY,
+                                "pathtracer temporal: out of memory for the deformed meshes' motion of %ux%u", req->rect_w,
+                                req->rect_h);
+    }
     const sy_rt_render_desc *ld = &st->last_desc; /* this render's camera and rectangle */
     sy_rt_render_desc d = {.image_width = ld->image_width, .image_height = ld->image_height, .x = ld->x, .y = ld->y,
                            .width = ld->width, .height = ld->height};
-    sy_rt_result rr = sy_rt_coverage(st->dev, &st->last_cam, &d, st->motion_ids, NULL);
+    const sy_rt_coverage_hit *hits = deform ? st->motion_hits : NULL;
+    double t0 = sy_time_now();
+    sy_rt_result rr = deform ? sy_rt_coverage_hits(st->dev, &st->last_cam, &d, st->motion_hits)
+                             : sy_rt_coverage(st->dev, &st->last_cam, &d, st->motion_ids, NULL);
     if (rr != SY_RT_OK) return sy_rti_fail(st, err, rr, "pathtracer temporal: object motion");
+    st->finfo.temporal_motion_trace_seconds = sy_time_now() - t0;
     float *mv = st->motion_buf;
     uint32_t last_id = 0;
-    const rt_move_rec *mr = NULL;
+    motion_run run = {0};
     for (size_t i = 0; i < n; ++i) {
-        uint32_t id = st->motion_ids[i];
+        uint32_t id = hits ? hits[i].instance : st->motion_ids[i];
         if (id != last_id) {
             last_id = id;
-            rt_move_rec *r = id ? sy_mirror_map_get(&st->temporal_from, id) : NULL;
-            if (r && !r->ready) { /* to_prev = prev now^-1, NaN when now has no inverse */
-                sy_mat4 now, inv, prev, tp;
-                r->ready = true;
-                if (sy_rt_instance_get_transform(st->dev, (sy_rt_instance){id}, now.m) == SY_RT_OK &&
-                    sy_mat4_invert(&now, &inv)) {
-                    memcpy(prev.m, r->prev, sizeof prev.m);
-                    tp = sy_mat4_mul(&prev, &inv);
-                    memcpy(r->to_prev, tp.m, sizeof tp.m);
-                } else {
-                    for (int k = 0; k < 16; ++k) r->to_prev[k] = NAN;
-                }
-            }
-            mr = r;
+            motion_run_get(st, id, deform, &run);
         }
         float *o = mv + 3 * i;
-        if (!mr) {
+        if (run.dr) { /* per vertex: the hit point at the earlier pose, through the earlier matrix */
+            const sy_rt_coverage_hit *h = &hits[i];
+            if (h->triangle < run.now.triangle_count) {
+                const uint32_t *ix = run.now.indices + 3u * h->triangle;
+                float a[3], b[3];
+                bary_point(run.prev, run.dr->prev, ix, h->u, h->v, a);
+                bary_point(run.xf, run.now.positions, ix, h->u, h->v, b);
+                for (int k = 0; k < 3; ++k) o[k] = a[k] - b[k];
+            } else {
+                o[0] = o[1] = o[2] = 0.0f;
+            }
+            if (o[0] != 0.0f || o[1] != 0.0f || o[2] != 0.0f) ++*pixels, ++*deformed;
+            continue;
+        }
+        if (!run.mr) {
             o[0] = o[1] = o[2] = 0.0f;
             continue;
         }
-        const float *p = pos + 3 * i, *m = mr->to_prev;
+        const float *p = pos + 3 * i, *m = run.mr->to_prev;
         for (int k = 0; k < 3; ++k) o[k] = m[k] * p[0] + m[4 + k] * p[1] + m[8 + k] * p[2] + m[12 + k] - p[k];
         if (o[0] != 0.0f || o[1] != 0.0f || o[2] != 0.0f) ++*pixels;
     }
@@ -422,8 +552,10 @@ void sy_rti_temporal_free(rt_state *st)
 {
     sy_filter_temporal_destroy(st->temporal);
     sy_mirror_map_free(&st->temporal_from);
+    deform_free(st);
     free(st->motion_ids);
     free(st->motion_buf);
+    free(st->motion_hits);
 }
 
 sy_result sy_rti_temporal_layer(rt_state *st, const sy_render_request *req, uint32_t samples, sy_layer *layer,
@@ -433,6 +565,7 @@ sy_result sy_rti_temporal_layer(rt_state *st, const sy_render_request *req, uint
     st->finfo.temporal_last = false, st->finfo.temporal_rest_last = false;
     st->temporal_rest = false;
     st->finfo.temporal_motion_seconds = 0.0, st->finfo.temporal_moving_pixels = 0;
+    st->finfo.temporal_deformed_pixels = 0, st->finfo.temporal_motion_trace_seconds = 0.0;
     if (!st->filter.temporal) return SY_OK;
     bool objects = objects_moved(st);
     bool moved = st->temporal_have_cam && (!sy_rti_same_view(&st->temporal_cam, &req->camera) || objects);
@@ -444,6 +577,7 @@ sy_result sy_rti_temporal_layer(rt_state *st, const sy_render_request *req, uint
     sy_result r = temporal_frame(st, req, samples, moved, layer, done, err);
     /* this render's transforms are the next one's previous ones */
     if (st->temporal_from.live) sy_mirror_map_free(&st->temporal_from);
+    deform_age(st); /* and its deformed poses the next one's earlier ones */
     return r;
 }
 
@@ -479,12 +613,13 @@ static sy_result temporal_frame(rt_state *st, const sy_render_request *req, uint
     struct timespec tm0, tm1;
     clock_gettime(CLOCK_MONOTONIC, &tm0);
     bool any = false;
-    uint64_t moving = 0;
-    if ((rd = object_motion(st, req, f.position, &any, &moving, err)) != SY_OK) return rd;
+    uint64_t moving = 0, deformed = 0;
+    if ((rd = object_motion(st, req, f.position, &any, &moving, &deformed, err)) != SY_OK) return rd;
     if (any) f.motion = st->motion_buf;
     clock_gettime(CLOCK_MONOTONIC, &tm1);
     st->finfo.temporal_motion_seconds = any ? (double)(tm1.tv_sec - tm0.tv_sec) + 1e-9 * (double)(tm1.tv_nsec - tm0.tv_nsec) : 0.0;
     st->finfo.temporal_moving_pixels = moving;
+    st->finfo.temporal_deformed_pixels = deformed;
     sy_filter_temporal_stats ts = {0};
     if (sy_filter_temporal_run(st->temporal, &f, m, layer->rgba, &ts, &fe)) return filter_fail(err, &fe);
     clock_gettime(CLOCK_MONOTONIC, &t1);

@@ -69,6 +69,7 @@ typedef struct pt_filter_cfg {
     sy_filter_radiance_params radiance; /* threshold T_u = the shared threshold */
     bool temporal;                      /* "temporal": reuse on frames whose camera or objects moved */
     bool temporal_motion;               /* "temporal_motion": object motion for the reprojection */
+    bool temporal_deform;               /* "temporal_deform": per-vertex motion of deforming meshes */
 } pt_filter_cfg;
 
 /* The scene mirror (textures, materials, meshes, lights, backgrounds, nodes and placements) is
@@ -82,6 +83,16 @@ typedef struct rt_move_rec {
     float to_prev[16];
     bool ready;
 } rt_move_rec;
+
+/* A mesh deformed since the last path-traced render (temporal reuse's per-vertex motion): its
+ * positions at that render, copied from the device before its first update since (cb_primitive
+ * update). A record not refreshed since the render before (its mesh stopped deforming) is freed at
+ * the next render; a fresh one keeps its buffer for the next copy. */
+typedef struct rt_deform_rec {
+    float *prev;           /* float3 x vertex_count, own */
+    uint32_t vertex_count;
+    bool fresh;            /* copied since the last render */
+} rt_deform_rec;
 
 typedef struct rt_motion_rec {
     float xf[SY_MOTION_STEPS_MAX][16];
@@ -138,6 +149,13 @@ typedef struct rt_state {
     uint32_t *motion_ids;
     float *motion_buf;
     size_t motion_px;
+    /* per-vertex motion (filter.temporal_deform): per rt mesh handle deformed since the last render,
+     * its positions then (rt_deform_rec; temporal_fresh of them copied since the last render); the
+     * coverage hits (instance, triangle, barycentrics) of the renders that have some */
+    sy_mirror_map temporal_deform;
+    uint32_t temporal_fresh;
+    sy_rt_coverage_hit *motion_hits;
+    size_t motion_hits_px;
     /* motion blur (SY_CAP_MOTION, sy_rti_motion): MOTION_ARMED between BEGIN and OPENED (the sync in
      * between gives each moved instance its close transform), MOTION_ON until END */
     enum { MOTION_OFF, MOTION_ARMED, MOTION_ON } motion;
@@ -161,7 +179,7 @@ typedef struct rt_state {
 /* The classes' parameter tables (sy_params.h); the counts are checked where they are defined. */
 #define SY_RTI_WHITTED_PARAM_COUNT 8
 #define SY_RTI_COVERAGE_PARAM_COUNT 5
-#define SY_RTI_PATHTRACER_PARAM_COUNT 28
+#define SY_RTI_PATHTRACER_PARAM_COUNT 29
 #ifndef SY_RTI_DEFINING_PARAMS
 extern const sy_param_decl sy_rti_whitted_params[SY_RTI_WHITTED_PARAM_COUNT];
 extern const sy_param_decl sy_rti_coverage_params[SY_RTI_COVERAGE_PARAM_COUNT];
@@ -217,7 +235,10 @@ sy_result sy_rti_filter_layer(rt_state *st, const sy_render_request *req, sy_lay
  * layer alone (*done false). Records the camera either way. */
 sy_result sy_rti_temporal_layer(rt_state *st, const sy_render_request *req, uint32_t samples, sy_layer *layer,
                                 bool *done, sy_error *err);
-/* Frees temporal reuse's state (the filter, the moved instances' matrices, the motion planes);
+/* Temporal reuse's per-vertex motion: keeps the pose of the rt mesh `mesh` at the last render
+ * (copied from the device) before the sync rewrites its vertices; called by cb_primitive_update. */
+void sy_rti_temporal_deform_record(rt_state *st, uint32_t mesh);
+/* Frees temporal reuse's state (the filter, the moved instances' matrices, the deformed meshes' earlier poses, the motion planes);
  * the context's destroy calls it. */
 void sy_rti_temporal_free(rt_state *st);
 /* Whether a path-traced render of req is a moving frame for temporal reuse: the camera moved since

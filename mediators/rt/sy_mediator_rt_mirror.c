@@ -165,6 +165,7 @@ static sy_result cb_primitive_update(void *user, const sy_mirror_primitive_args 
 {
     rt_state *st = user;
     sy_rt_mesh h = {*a->handle};
+    sy_rti_temporal_deform_record(st, h.id); /* temporal reuse: its pose at the last render, before it changes */
     /* more than two steps: this sync's step (the close kept from the first deformation on) */
     sy_rt_result r = st->motion != MOTION_ARMED ? sy_rt_mesh_update(st->dev, h, a->flat->positions, a->flat->normals)
                      : st->motion_steps > 2u
