@@ -23,8 +23,13 @@
  *   - the frames with it count the deformed pixels given per-vertex motion; without it none.
  * Then the meshes stop deforming and the camera pans: the frames carry no per-vertex motion (the
  * earlier poses were dropped), and turning temporal_deform off and on live changes nothing else.
+ * Last, a skin loaded from glTF (the Khronos CesiumMan of ../shared/testdata; that part is skipped
+ * with the reason when absent) walking under a still camera: every frame after the first gets
+ * per-vertex motion on the figure, none with temporal_deform=0, and the two contexts' images differ
+ * only where the figure is (the background's pixels are the same bit for bit).
  * Prints the numbers per frame. */
 #include "it_util.h"
+#include "sy_anim.h"
 #include "sy_mediator_rt.h"
 
 #define W 64
@@ -219,6 +224,69 @@ static void rel_mse(const sy_layer *a, const sy_layer *ref, const uint8_t *mask,
 
 static const char *const class_name[3] = {"wall", "skinned bar", "morphing patch"};
 
+/* CesiumMan walking (frames of 1/24 s) under a still camera, 1 spp a frame, temporal reuse with and
+ * without per-vertex motion. */
+static void loaded_skin(void)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/gltf/CesiumMan/glTF/CesiumMan.gltf", SY_TESTDATA_DIR);
+    if (access(path, R_OK) != 0) {
+        printf("CesiumMan part skipped: test data %s not found\n", path);
+        return;
+    }
+    sy_gltf_info info;
+    sy_scene *s = it_load_gltf(path, &info);
+    MUST(sy_scene_set_time(s, (sy_animation){0}, 0.0, err));
+    MUST(sy_scene_commit(s, NULL, err));
+    sy_camera_view view = it_view_down_z(3.2f, 0.27f); /* from the side, as integration_skin */
+    view.camera_to_world.m[13] = 0.72f;
+    view.window[0] = -0.27f * (float)W / (float)H, view.window[1] = 0.27f * (float)W / (float)H;
+    sy_context *ctx[2];
+    for (int k = 0; k < 2; ++k) {
+        MUST(sy_context_create(s, "pathtracer", NULL, info.root.id, &ctx[k], err));
+        sy_params p = {0};
+        MUST(sy_params_set(&p, "temporal", "1", err));
+        MUST(sy_params_set(&p, "temporal_deform", k ? "0" : "1", err));
+        MUST(sy_context_set_filter(ctx[k], "none", &p, err));
+    }
+    for (int f = 0; f < 4; ++f) {
+        MUST(sy_scene_set_time(s, (sy_animation){0}, (double)f / 24.0, err));
+        MUST(sy_scene_commit(s, NULL, err));
+        sy_layer img[2];
+        sy_mediator_rt_filter_info fi[2];
+        for (int k = 0; k < 2; ++k) {
+            MUST(sy_context_sync(ctx[k], err));
+            MUST(it_render_full(ctx[k], &view, W, H, 1, &img[k], err));
+            sy_mediator_rt_filter_info_get(sy_context_state(ctx[k]), &fi[k]);
+        }
+        size_t figure = 0, differ = 0, differ_outside = 0;
+        for (size_t i = 0; i < (size_t)W * H; ++i) {
+            bool in = isfinite(img[0].depth[i]) || isfinite(img[1].depth[i]);
+            bool d = memcmp(img[0].rgba + 4 * i, img[1].rgba + 4 * i, 4 * sizeof(float)) != 0;
+            figure += in, differ += d;
+            differ_outside += d && !in;
+        }
+        printf("CesiumMan frame %d: %llu pixels with per-vertex motion (%zu figure pixels), %llu without; %zu pixels "
+               "differ, %zu of them off the figure\n",
+               f, (unsigned long long)fi[0].temporal_deformed_pixels, figure,
+               (unsigned long long)fi[1].temporal_deformed_pixels, differ, differ_outside);
+        if (f > 0) {
+            EXPECT_MSG(fi[0].temporal_last && fi[0].temporal_deformed_pixels > figure / 4,
+                       "CesiumMan frame %d: estimate %d, %llu pixels with per-vertex motion of %zu", f, fi[0].temporal_last,
+                       (unsigned long long)fi[0].temporal_deformed_pixels, figure);
+            EXPECT_MSG(fi[1].temporal_last && fi[1].temporal_deformed_pixels == 0,
+                       "CesiumMan frame %d without per-vertex motion: estimate %d, %llu deformed pixels", f,
+                       fi[1].temporal_last, (unsigned long long)fi[1].temporal_deformed_pixels);
+        }
+        if (f > 1) EXPECT_MSG(differ > 0, "CesiumMan frame %d: the per-vertex motion changed no pixel", f);
+        EXPECT_MSG(differ_outside == 0, "CesiumMan frame %d: %zu pixels off the figure differ", f, differ_outside);
+        for (int k = 0; k < 2; ++k) sy_layer_destroy(&img[k]);
+    }
+    for (int k = 0; k < 2; ++k) sy_context_release(ctx[k]);
+    sy_gltf_info_free(&info);
+    sy_scene_destroy(s);
+}
+
 int main(void)
 {
     it_register();
@@ -317,5 +385,6 @@ int main(void)
                    (unsigned long long)fi.temporal_deformed_pixels);
     }
     destroy(&fx);
+    loaded_skin();
     return sy_check_finish("integration_pathtracer_deform");
 }
