@@ -108,6 +108,38 @@ static sy_result bench_win_make(const sy_viewport_desc *vd, const char *params, 
 }
 
 static sy_result bench_win_frame(bench_win *b, const sy_mat4 *view, sy_scene *scene, sy_context_pool *pool,
+                                 uint32_t samples, uint32_t seed, sy_layer *out, double *secs, sy_error *err);
+
+/* Sorts three series of 12 frames each (their medians at [6]). */
+static void sort12(double *a, double *b, double *c)
+{
+    qsort(a, 12, sizeof a[0], sy_bench_cmp_double);
+    qsort(b, 12, sizeof b[0], sy_bench_cmp_double);
+    qsort(c, 12, sizeof c[0], sy_bench_cmp_double);
+}
+
+/* One frame k of the object motion measurements: the scene (moved by the caller) committed and
+ * rendered under the path's first view at 1 spp; for k > 0 the motion pass's seconds into
+ * motion[k - 1], the rest of the temporal stage into rest[k - 1] and the motion pass without its
+ * coverage rays into pixels[k - 1]; *fi the context's filter info. */
+static sy_result motion_frame(bench_win *cost, const sy_interactive_input *home, sy_scene *scene, sy_context_pool *pool,
+                              sy_context *ctx, uint32_t k, sy_layer *a, sy_mediator_rt_filter_info *fi, double *motion,
+                              double *rest, double *pixels, sy_error *err)
+{
+    sy_result r = sy_scene_commit(scene, NULL, err);
+    sy_mat4 m;
+    path_view(home, 0, &m);
+    double s;
+    if (r == SY_OK) r = bench_win_frame(cost, &m, scene, pool, 1, 0, a, &s, err);
+    if (r == SY_OK && k > 0) {
+        sy_mediator_rt_filter_info_get(sy_context_state(ctx), fi);
+        motion[k - 1] = fi->temporal_motion_seconds, rest[k - 1] = fi->temporal_seconds - fi->temporal_motion_seconds;
+        pixels[k - 1] = fi->temporal_motion_seconds - fi->temporal_motion_trace_seconds;
+    }
+    return r;
+}
+
+static sy_result bench_win_frame(bench_win *b, const sy_mat4 *view, sy_scene *scene, sy_context_pool *pool,
                                  uint32_t samples, uint32_t seed, sy_layer *out, double *secs, sy_error *err)
 {
     sy_viewport_set_view(b->vp, view);
@@ -262,9 +294,7 @@ sy_result sy_bench_temporal(sy_scene *scene, const sy_viewport_desc *vd, const c
         }
     }
     if (r == SY_OK) {
-        qsort(tt, 12, sizeof tt[0], sy_bench_cmp_double);
-        qsort(tf, 12, sizeof tf[0], sy_bench_cmp_double);
-        qsort(tc, 12, sizeof tc[0], sy_bench_cmp_double);
+        sort12(tt, tf, tc);
         printf("  cost at 640x360: temporal stage %.1f ms per frame (median of 12; AOV read + reprojection + "
                "a-trous), the 1-spp frame without it %.1f ms: %.2fx; the filter's CPU time %.1f ms (all threads); "
                "reused history on %.0f %% of the hits\n",
@@ -288,25 +318,14 @@ sy_result sy_bench_temporal(sy_scene *scene, const sy_viewport_desc *vd, const c
             m.m[12] += 0.002f * home.orbit.dist * (float)k;
             r = sy_node_set_matrix(scene, (sy_node){kids[i]}, &m, err);
         }
-        if (r == SY_OK) r = sy_scene_commit(scene, NULL, err);
-        sy_mat4 m;
-        path_view(&home, 0, &m);
-        double s;
-        if (r == SY_OK) r = bench_win_frame(&cost, &m, scene, pool, 1, 0, &a, &s, err);
-        if (r == SY_OK && k > 0) {
-            sy_mediator_rt_filter_info_get(sy_context_state(ctx), &fi);
-            om[k - 1] = fi.temporal_motion_seconds, os[k - 1] = fi.temporal_seconds - fi.temporal_motion_seconds;
-            ot[k - 1] = fi.temporal_motion_seconds - fi.temporal_motion_trace_seconds;
-            moving = fi.temporal_moving_pixels;
-        }
+        if (r == SY_OK) r = motion_frame(&cost, &home, scene, pool, ctx, k, &a, &fi, om, os, ot, err);
+        moving = fi.temporal_moving_pixels;
     }
     if (saved) { /* the scene as it was */
         for (uint32_t i = 0; i < nkids; ++i) (void)sy_node_set_matrix(scene, (sy_node){kids[i]}, &saved[i], NULL);
         (void)sy_scene_commit(scene, NULL, NULL);
         if (r == SY_OK) {
-            qsort(om, 12, sizeof om[0], sy_bench_cmp_double);
-            qsort(os, 12, sizeof os[0], sy_bench_cmp_double);
-            qsort(ot, 12, sizeof ot[0], sy_bench_cmp_double);
+            sort12(om, os, ot);
             printf("  object motion at 640x360 (still camera, every instance sliding): motion pass %.2f ms per frame "
                    "(median of 12; coverage rays + per-pixel motion, of it the per-pixel motion %.2f ms), the rest of "
                    "the temporal stage %.1f ms: %.2fx; %llu moving pixels\n",
@@ -327,22 +346,11 @@ sy_result sy_bench_temporal(sy_scene *scene, const sy_viewport_desc *vd, const c
         r = sy_scene_set_time_ex(scene, (sy_animation){0}, (double)k / 24.0, &as, err);
         if (r != SY_OK || (k == 0 && as.channels == 0 && as.weights == 0)) break;
         animated = true;
-        r = sy_scene_commit(scene, NULL, err);
-        sy_mat4 m;
-        path_view(&home, 0, &m);
-        double s;
-        if (r == SY_OK) r = bench_win_frame(&cost, &m, scene, pool, 1, 0, &a, &s, err);
-        if (r == SY_OK && k > 0) {
-            sy_mediator_rt_filter_info_get(sy_context_state(ctx), &fi);
-            dm[k - 1] = fi.temporal_motion_seconds, ds[k - 1] = fi.temporal_seconds - fi.temporal_motion_seconds;
-            dt[k - 1] = fi.temporal_motion_seconds - fi.temporal_motion_trace_seconds;
-            dpx = fi.temporal_deformed_pixels, dmov = fi.temporal_moving_pixels;
-        }
+        r = motion_frame(&cost, &home, scene, pool, ctx, k, &a, &fi, dm, ds, dt, err);
+        dpx = fi.temporal_deformed_pixels, dmov = fi.temporal_moving_pixels;
     }
     if (r == SY_OK && animated) {
-        qsort(dm, 12, sizeof dm[0], sy_bench_cmp_double);
-        qsort(ds, 12, sizeof ds[0], sy_bench_cmp_double);
-        qsort(dt, 12, sizeof dt[0], sy_bench_cmp_double);
+        sort12(dm, ds, dt);
         printf("  animation at 640x360 (still camera, every clip at 24 fps): motion pass %.2f ms per frame (median of "
                "12; per-vertex motion on %llu deformed pixels of %llu moving; of it the per-pixel motion %.2f ms), the "
                "rest of the temporal stage %.1f ms: %.2fx; the rigid pass above %.2f ms: %.2fx of it\n",

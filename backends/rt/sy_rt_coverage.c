@@ -39,34 +39,34 @@ static void coverage_hits_tile(const sy_rt_frame *f, void *user, uint32_t x0, ui
     sy_rt_frame_tile_hits(f, x0, y0, x1, y1, coverage_full_hit, user);
 }
 
-sy_rt_result sy_rt_coverage_hits(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc,
-                                  sy_rt_coverage_hit *hits)
+/* One coverage pass (what: "coverage" or "coverage hits", for messages): tile_fn over every tile
+ * with out (ids or hits); depth as sy_rt_coverage's */
+static sy_rt_result coverage_run(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc,
+                                 const char *what, void (*tile_fn)(const sy_rt_frame *, void *, uint32_t, uint32_t, uint32_t, uint32_t),
+                                 void *out, float *depth)
 {
     if (dev && camera) sy_rt_clip_begin(dev, camera);
-    if (!dev || !camera || !desc || !hits) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "coverage hits: NULL argument");
+    if (!dev || !camera || !desc || !out) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "%s: NULL argument", what);
     if (dev->dirty)
-        return FAIL(SY_RT_ERROR_INVALID_OPERATION, "coverage hits: the device has uncommitted changes; call sy_rt_commit first");
-    sy_rt_render_desc d = *desc;
-    d.integrator = SY_RT_INTEGRATOR_COVERAGE;
-    sy_rt_frame f;
-    sy_rt_result r = sy_rt_frame_init(&f, dev, camera, &d, NULL, NULL);
-    if (r != SY_RT_OK) return r;
-    return sy_rt_run_tiles(&f, coverage_hits_tile, hits, desc->progress, desc->progress_user_data);
-}
-
-sy_rt_result sy_rt_coverage(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc,
-                            uint32_t *ids, float *depth)
-{
-    if (dev && camera) sy_rt_clip_begin(dev, camera);
-    if (!dev || !camera || !desc || !ids) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "coverage: NULL argument");
-    if (dev->dirty)
-        return FAIL(SY_RT_ERROR_INVALID_OPERATION, "coverage: the device has uncommitted changes; call sy_rt_commit first");
+        return FAIL(SY_RT_ERROR_INVALID_OPERATION, "%s: the device has uncommitted changes; call sy_rt_commit first", what);
     sy_rt_render_desc d = *desc;
     d.integrator = SY_RT_INTEGRATOR_COVERAGE;
     sy_rt_frame f;
     sy_rt_result r = sy_rt_frame_init(&f, dev, camera, &d, NULL, depth);
     if (r != SY_RT_OK) return r;
-    return sy_rt_run_tiles(&f, sy_rt_coverage_tile, ids, desc->progress, desc->progress_user_data);
+    return sy_rt_run_tiles(&f, tile_fn, out, desc->progress, desc->progress_user_data);
+}
+
+sy_rt_result sy_rt_coverage_hits(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc,
+                                  sy_rt_coverage_hit *hits)
+{
+    return coverage_run(dev, camera, desc, "coverage hits", coverage_hits_tile, hits, NULL);
+}
+
+sy_rt_result sy_rt_coverage(sy_rt_device *dev, const sy_rt_camera *camera, const sy_rt_render_desc *desc,
+                            uint32_t *ids, float *depth)
+{
+    return coverage_run(dev, camera, desc, "coverage", sy_rt_coverage_tile, ids, depth);
 }
 
 sy_rt_result sy_rt_pick(sy_rt_device *dev, const sy_rt_camera *camera, uint32_t image_width, uint32_t image_height,
