@@ -31,13 +31,15 @@ typedef struct coop_run {
     double cpu[2];     /* each server's CPU seconds in that time (< 0: unknown) */
     uint64_t samples;  /* merged samples per pixel added in that time */
     uint32_t frames;
+    uint32_t answers, pipelined; /* server answers in the timed frames; those requested ahead */
 } coop_run;
 
 /* Cooperative path tracing on the first n servers with a fresh client (snapshot + translation in a
- * warm-up frame that is not counted), spf samples per server and frame, frames until at least
- * min_seconds have passed (and at least 3). *spf == 0: calibrated here from a 4-sample frame so
- * that a frame takes about 0.4 s (the client's per-frame transfer and merge stay small next to
- * the rendering), and returned for the other runs. */
+ * warm-up frame and one more frame that are not counted: the timed frames are pipelined, each
+ * server's next request sent before the client merges), spf samples per server and frame, frames
+ * until at least min_seconds have passed (and at least 3). *spf == 0: calibrated here from a
+ * 4-sample frame so that a frame takes about frame_s on one server, and returned for the other
+ * runs. */
 static sy_result coop_measure(sy_scene *scene, const sy_viewport_desc *vd, const sy_bench_cluster_server *srv, uint32_t n,
                               uint32_t w, uint32_t h, uint32_t *spf, double frame_s, double min_seconds, coop_run *out,
                               sy_error *err)
@@ -48,23 +50,31 @@ static sy_result coop_measure(sy_scene *scene, const sy_viewport_desc *vd, const
     sy_bench_cluster_rig rig;
     sy_result r = sy_bench_cluster_rig_open(scene, vd, &co, w, h, &rig, err);
     sy_cluster_frame f = {.mode = SY_CLUSTER_COOPERATIVE, .backend = "pathtracer", .root_id = vd->root.id,
-                          .background_id = vd->background.id, .camera = rig.view, .width = w, .height = h, .samples = 4};
+                          .background_id = vd->background.id, .camera = rig.view, .width = w, .height = h,
+                          .samples = *spf ? *spf : 4};
     sy_cluster_frame_stats st = {0};
     if (r == SY_OK) r = sy_cluster_client_render(rig.client, &f, &rig.img, &st, err); /* warm-up: snapshot + translation */
+    uint32_t untimed = 1; /* a frame that asks what the last one asked: the client pipelines from the next on */
     if (r == SY_OK && !*spf) {
         double t = sy_time_now();
         r = sy_cluster_client_render(rig.client, &f, &rig.img, &st, err);
         t = sy_time_now() - t;
         double k = t > 0 ? frame_s / t : 256.0;
         *spf = k >= 256.0 ? 1024u : k <= 1.0 ? 4u : (uint32_t)(4.0 * k + 0.5);
+        untimed = 2; /* the first at spf asks otherwise (its stale 4-sample answers are dropped) */
     }
     f.samples = *spf;
+    /* untimed frames at spf, so that every timed frame is in the steady state (each server's next
+     * request already sent when a frame returns, as in a long refinement) */
+    for (uint32_t i = 0; i < untimed && r == SY_OK; ++i) r = sy_cluster_client_render(rig.client, &f, &rig.img, &st, err);
     uint64_t s0 = st.samples;
     double cpu0[2] = {proc_cpu_seconds(srv[0].pid), n > 1 ? proc_cpu_seconds(srv[1].pid) : -1.0};
     double t0 = sy_time_now();
     while (r == SY_OK && (out->frames < 3 || sy_time_now() - t0 < min_seconds)) {
         r = sy_cluster_client_render(rig.client, &f, &rig.img, &st, err);
         out->frames++;
+        out->answers += st.servers_live;
+        out->pipelined += st.pipelined;
         if (r == SY_OK && st.servers_live != n)
             r = sy_error_set(err, SY_ERR_IO, "bench: a server dropped out of the cooperative measurement");
     }
@@ -114,9 +124,9 @@ sy_result sy_bench_cluster_coop(sy_scene *scene, const sy_viewport_desc *vd, con
             ne++;
         }
         printf("    round %u (%u spp per server and frame): 1 server %.1f spp/s (busy %.2f s CPU of %.2f s); "
-               "2 servers %.1f spp/s (busy %.2f + %.2f s CPU of %.2f s): %.2fx\n",
+               "2 servers %.1f spp/s (busy %.2f + %.2f s CPU of %.2f s): %.2fx; answers requested ahead %u/%u\n",
                round + 1, spf, run[0].rate, run[0].cpu[0], run[0].seconds, run[1].rate, run[1].cpu[0], run[1].cpu[1],
-               run[1].seconds, ratio[nr - 1]);
+               run[1].seconds, ratio[nr - 1], run[0].pipelined + run[1].pipelined, run[0].answers + run[1].answers);
     }
     if (r == SY_OK && nr) {
         sy_bench_spread sr = sy_bench_spread_of(ratio, nr), s1 = sy_bench_spread_of(rate[0], nr),

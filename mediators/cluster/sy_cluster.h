@@ -138,6 +138,12 @@ typedef struct sy_cluster_client_opts {
      * multi-display mode ({0} entry = column i of n). */
     const char *const *backends;
     const sy_cluster_rect *wall_tiles; /**< optional, see above */
+    /** Cooperative frames are pipelined by default: once a server's RENDER of a frame is the same as
+     * the one of the frame before (no SCENE, same view, samples, parameters), the next frame's RENDER
+     * goes to it as soon as its answer is in, so it renders while the client merges; a next frame
+     * that asks otherwise receives and drops that answer first (at most one round per server).
+     * true = never send ahead (each frame's requests only once it is asked for). */
+    bool no_pipeline;
 } sy_cluster_client_opts;
 
 /** A cluster client: connections to the servers and their scene consumers (opaque). */
@@ -189,6 +195,8 @@ typedef struct sy_cluster_frame_stats {
     /** @{ everything on the wire this frame */
     uint64_t bytes_sent, bytes_received; /** @} */
     uint64_t samples;        /**< cooperative: merged samples per pixel */
+    uint32_t pipelined;      /**< cooperative: answers used that were requested ahead, before this frame's call */
+    uint32_t stale;          /**< answers to requests sent ahead that this frame dropped (it asked otherwise) */
     double seconds;          /**< whole frame on the client */
     double max_server_seconds; /**< slowest server's sync + render time */
 } sy_cluster_frame_stats;

@@ -16,6 +16,8 @@ void sy_clu_conn_close(conn *k)
     sodium_memzero(k->w.key, sizeof k->w.key);
     memset(&k->w, 0, sizeof k->w);
     k->live = k->session_open = false;
+    k->ahead.size = 0; /* a request sent ahead dies with the connection */
+    k->last_req.size = 0;
 }
 
 void sy_clu_conn_drop(sy_cluster_client *c, conn *k, const char *what, const char *why)
@@ -32,36 +34,95 @@ static uint64_t conn_body_limit(const conn *k)
     return k->session_open ? k->srv_max_message : SY_CLUSTER_HANDSHAKE_MAX_FRAME - SY_CLUSTER_HEADER_SIZE;
 }
 
+/* The deadline of a request sent now (or of an answer awaited from now). */
+static double conn_deadline(const sy_cluster_client *c, const conn *k)
+{
+    return sy_time_now() + (k->session_open ? c->timeout_ms : c->connect_timeout_ms) / 1000.0;
+}
+
+/* Sends one encoded (untagged) message within the deadline, refusing one larger than the server
+ * accepts. */
+static sy_result conn_send(sy_cluster_client *c, conn *k, const sy_cluster_buf *b, double deadline, sy_error *err)
+{
+    (void)c;
+    if (!k->w.st) return sy_error_set(err, SY_ERR_IO, "%s: not connected", k->url);
+    if (b->size - SY_CLUSTER_HEADER_SIZE > conn_body_limit(k))
+        return sy_error_set(err, SY_ERR_LIMIT, "%s: a %s of %zu bytes exceeds the server's message limit of %llu", k->url,
+                            sy_cluster_msg_type_name((uint32_t)b->data[6] | ((uint32_t)b->data[7] << 8)),
+                            b->size - SY_CLUSTER_HEADER_SIZE, (unsigned long long)conn_body_limit(k));
+    uint64_t seq0 = k->w.send_seq;
+    size_t max_frame = k->session_open ? k->srv_max_frame : SY_CLUSTER_HANDSHAKE_MAX_FRAME;
+    sy_result r = sy_clu_wire_send(&k->w, b->data, b->size, max_frame, deadline, 0, k->url, err);
+    uint64_t frames = k->w.send_seq - seq0; /* headers and tags of every frame, plus the body */
+    if (frames)
+        k->bytes_sent += b->size + (frames - 1) * SY_CLUSTER_HEADER_SIZE + (k->w.tagged ? frames * SY_CLUSTER_TAG_SIZE : 0);
+    return r;
+}
+
+sy_result sy_clu_conn_send_ahead(sy_cluster_client *c, conn *k, uint64_t frame, uint32_t job, sy_error *err)
+{
+    k->ahead_frame = frame;
+    k->ahead_job = job;
+    sy_result r = conn_send(c, k, &k->ahead, conn_deadline(c, k), err);
+    if (r) k->ahead.size = 0;
+    return r;
+}
+
+sy_result sy_clu_conn_drain(sy_cluster_client *c, conn *k, sy_error *err)
+{
+    if (!k->ahead.size) return SY_OK;
+    k->ahead.size = 0;
+    sy_cluster_msg rep;
+    uint8_t *raw = NULL;
+    sy_result r = sy_clu_conn_recv(c, k, SY_CLUSTER_TILES, &rep, &raw, err);
+    if (r) return r;
+    if (rep.u.tiles.frame != k->ahead_frame || rep.u.tiles.job != k->ahead_job)
+        r = sy_error_set(err, SY_ERR_PROTOCOL, "%s: answer for frame %llu job %u, while the request sent ahead was frame %llu job %u",
+                         k->url, (unsigned long long)rep.u.tiles.frame, rep.u.tiles.job,
+                         (unsigned long long)k->ahead_frame, k->ahead_job);
+    else k->ahead_dropped++;
+    sy_cluster_msg_free(&rep);
+    free(raw);
+    return r;
+}
+
 /* One request/reply exchange within timeout_ms (the handshake's deadline before the session is
- * open). *reply borrows *raw (free it with free() after sy_cluster_msg_free). */
+ * open); an answer still owed to a request sent ahead is received and dropped first
+ * (sy_clu_conn_drain). *reply borrows *raw (free it with free() after sy_cluster_msg_free). */
 sy_result sy_clu_conn_call(sy_cluster_client *c, conn *k, sy_cluster_msg *req, const sy_cluster_buf *preencoded,
                            uint32_t expect, sy_cluster_msg *reply, uint8_t **raw, sy_error *err)
 {
     *raw = NULL;
     memset(reply, 0, sizeof *reply);
     if (!k->w.st) return sy_error_set(err, SY_ERR_IO, "%s: not connected", k->url);
-    double deadline = sy_time_now() + (k->session_open ? c->timeout_ms : c->connect_timeout_ms) / 1000.0;
+    sy_result r = sy_clu_conn_drain(c, k, err);
+    if (r) return r;
+    double deadline = conn_deadline(c, k);
     sy_cluster_buf buf = {0};
     const sy_cluster_buf *b = preencoded;
-    sy_result r = SY_OK;
     if (!b) {
         r = sy_cluster_encode(req, 0, &buf, err);
         b = &buf;
     }
-    if (r == SY_OK && b->size - SY_CLUSTER_HEADER_SIZE > conn_body_limit(k))
-        r = sy_error_set(err, SY_ERR_LIMIT, "%s: a %s of %zu bytes exceeds the server's message limit of %llu", k->url,
-                         sy_cluster_msg_type_name((uint32_t)b->data[6] | ((uint32_t)b->data[7] << 8)),
-                         b->size - SY_CLUSTER_HEADER_SIZE, (unsigned long long)conn_body_limit(k));
-    if (r == SY_OK) {
-        uint64_t seq0 = k->w.send_seq;
-        size_t max_frame = k->session_open ? k->srv_max_frame : SY_CLUSTER_HANDSHAKE_MAX_FRAME;
-        r = sy_clu_wire_send(&k->w, b->data, b->size, max_frame, deadline, 0, k->url, err);
-        uint64_t frames = k->w.send_seq - seq0; /* headers and tags of every frame, plus the body */
-        if (frames)
-            k->bytes_sent += b->size + (frames - 1) * SY_CLUSTER_HEADER_SIZE + (k->w.tagged ? frames * SY_CLUSTER_TAG_SIZE : 0);
-    }
+    if (r == SY_OK) r = conn_send(c, k, b, deadline, err);
     sy_cluster_buf_free(&buf);
     if (r) return r;
+    return sy_clu_conn_recv_until(c, k, expect, deadline, reply, raw, err);
+}
+
+sy_result sy_clu_conn_recv(sy_cluster_client *c, conn *k, uint32_t expect, sy_cluster_msg *reply, uint8_t **raw,
+                           sy_error *err)
+{
+    return sy_clu_conn_recv_until(c, k, expect, conn_deadline(c, k), reply, raw, err);
+}
+
+sy_result sy_clu_conn_recv_until(sy_cluster_client *c, conn *k, uint32_t expect, double deadline, sy_cluster_msg *reply,
+                                 uint8_t **raw, sy_error *err)
+{
+    *raw = NULL;
+    memset(reply, 0, sizeof *reply);
+    if (!k->w.st) return sy_error_set(err, SY_ERR_IO, "%s: not connected", k->url);
+    sy_result r;
     const sy_cluster_budget budget = k->session_open
                                          ? (sy_cluster_budget){c->max_frame, c->max_message, true, k->w.tagged}
                                          : (sy_cluster_budget){SY_CLUSTER_HANDSHAKE_MAX_FRAME,
@@ -263,6 +324,8 @@ void sy_cluster_client_destroy(sy_cluster_client *c)
         }
         sy_clu_conn_close(k);
         sy_cluster_buf_free(&k->scene_msg);
+        sy_cluster_buf_free(&k->ahead);
+        sy_cluster_buf_free(&k->last_req);
         sy_blob_store_destroy(k->offered);
         if (k->has_consumer) sy_scene_consumer_remove(c->scene, k->consumer);
     }

@@ -46,7 +46,13 @@ typedef struct frame_ctx {
     uint64_t *accum_samples;
     work_item *items;
     uint32_t item_count;
+    uint32_t first_items; /* items of the first round (later ones reassign failed work) */
     double *server_seconds;
+    /* cooperative pipelining */
+    bool pipeline;        /* requests of the next frame may be sent ahead */
+    uint32_t coop_span;   /* the frame's sample indices: the next frame's ranges are these + span */
+    bool *ahead_hit;      /* per connection: its request sent ahead is this frame's (its answer is used) */
+    bool *single;         /* per connection: exactly one item of the first round */
 } frame_ctx;
 
 typedef struct thread_arg {
@@ -66,14 +72,14 @@ static bool blob_send_cb(void *user, const sy_blob *b)
     return false;
 }
 
-static sy_result run_item(frame_ctx *fc, conn *k, uint32_t idx, work_item *it, sy_error *err)
+/* The RENDER of work item it for server idx (conn k) in this frame (m's pointers borrow it and f). */
+static void make_render(const frame_ctx *fc, const conn *k, uint32_t idx, const work_item *it, sy_cluster_msg *m)
 {
-    sy_cluster_client *c = fc->c;
+    const sy_cluster_client *c = fc->c;
     const sy_cluster_frame *f = fc->f;
-    sy_cluster_msg m, rep;
-    memset(&m, 0, sizeof m);
-    m.header.type = SY_CLUSTER_RENDER;
-    __typeof__(m.u.render) *q = &m.u.render;
+    memset(m, 0, sizeof *m);
+    m->header.type = SY_CLUSTER_RENDER;
+    __typeof__(m->u.render) *q = &m->u.render;
     q->frame = c->frame;
     q->job = (uint32_t)(it - fc->items);
     q->flags = (f->depth ? SY_CLUSTER_RENDER_DEPTH : 0) | (f->mode == SY_CLUSTER_MULTI_DISPLAY ? SY_CLUSTER_RENDER_PRESENT : 0) |
@@ -94,20 +100,73 @@ static sy_result run_item(frame_ctx *fc, conn *k, uint32_t idx, work_item *it, s
     q->full_height = f->height;
     q->camera = fc->views[it->eye];
     q->tile_count = 1;
-    q->tiles = &it->rect;
+    q->tiles = (sy_cluster_rect *)&it->rect;
+}
+
+/* Cooperative pipelining: whether k's RENDER m is the one of its last frame, the frame before (frame,
+ * sample_first and RESTART aside: a frame asked again); records m as k's last either way. */
+static bool steady_request(const sy_cluster_client *c, conn *k, const sy_cluster_msg *m)
+{
+    sy_cluster_msg n = *m;
+    n.u.render.frame = 0;
+    n.u.render.sample_first = 0;
+    n.u.render.flags &= ~(uint32_t)SY_CLUSTER_RENDER_RESTART;
+    sy_cluster_buf b = {0}, old = k->last_req;
+    sy_error e = {0};
+    bool ok = sy_cluster_encode(&n, 0, &b, &e) == SY_OK;
+    bool same = ok && old.size && k->last_req_frame + 1 == c->frame && b.size == old.size && !memcmp(b.data, old.data, b.size);
+    if (!ok) sy_cluster_buf_free(&b);
+    k->last_req = b;
+    k->last_req_frame = c->frame;
+    sy_cluster_buf_free(&old);
+    return same;
+}
+
+/* Runs one item on k: its RENDER (or the answer to the same request sent ahead), checks the answer,
+ * and decodes it. Cooperative, when k asked the same in the frame before: the next frame's RENDER
+ * goes to k as soon as this answer is in, before it is decoded and merged (a failure to send it is
+ * left in *ahead_err: this answer still counts, the connection is dropped after). */
+static sy_result run_item(frame_ctx *fc, conn *k, uint32_t idx, work_item *it, sy_error *ahead_err, sy_error *err)
+{
+    sy_cluster_client *c = fc->c;
+    const sy_cluster_frame *f = fc->f;
+    sy_cluster_msg m, rep;
+    make_render(fc, k, idx, it, &m);
+    const __typeof__(m.u.render) *q = &m.u.render;
+    bool first_round = (uint32_t)(it - fc->items) < fc->first_items;
     uint8_t *raw = NULL;
-    sy_result r = sy_clu_conn_call(c, k, &m, NULL, SY_CLUSTER_TILES, &rep, &raw, err);
+    sy_result r;
+    if (first_round && fc->ahead_hit && fc->ahead_hit[idx] && k->ahead.size) {
+        k->ahead.size = 0; /* this is its answer */
+        k->ahead_used++;
+        r = sy_clu_conn_recv(c, k, SY_CLUSTER_TILES, &rep, &raw, err);
+    } else {
+        r = sy_clu_conn_call(c, k, &m, NULL, SY_CLUSTER_TILES, &rep, &raw, err); /* drops a stale answer first */
+    }
     if (r) return r;
     const __typeof__(rep.u.tiles) *t = &rep.u.tiles;
     uint32_t expect_tiles = f->mode == SY_CLUSTER_MULTI_DISPLAY ? 0 : 1;
     if (t->frame != c->frame || t->job != q->job || t->tile_count != expect_tiles)
         r = sy_error_set(err, SY_ERR_PROTOCOL, "%s: reply for frame %llu job %u with %u tiles does not match the request",
                          k->url, (unsigned long long)t->frame, t->job, t->tile_count);
+    if (!r && expect_tiles && memcmp(&t->tiles[0].rect, &it->rect, sizeof it->rect) != 0)
+        r = sy_error_set(err, SY_ERR_PROTOCOL, "%s: tile rectangle differs from the request", k->url);
+    /* pipelining: the next frame's request goes out before this answer is decoded and merged */
+    if (!r && first_round && f->mode == SY_CLUSTER_COOPERATIVE && fc->single && fc->single[idx]) {
+        bool steady = steady_request(c, k, &m);
+        if (steady && fc->pipeline && !k->scene_msg.size) {
+            m.u.render.frame = c->frame + 1;
+            m.u.render.sample_first = it->sample_first + fc->coop_span;
+            m.u.render.flags &= ~(uint32_t)SY_CLUSTER_RENDER_RESTART;
+            k->ahead.size = 0;
+            sy_result ra = sy_cluster_encode(&m, 0, &k->ahead, ahead_err);
+            if (ra == SY_OK) ra = sy_clu_conn_send_ahead(c, k, c->frame + 1, m.u.render.job, ahead_err);
+            if (ra != SY_OK) k->ahead.size = 0;
+        }
+    }
     if (!r && expect_tiles) {
         const sy_cluster_tile *tl = &t->tiles[0];
-        if (memcmp(&tl->rect, &it->rect, sizeof tl->rect) != 0)
-            r = sy_error_set(err, SY_ERR_PROTOCOL, "%s: tile rectangle differs from the request", k->url);
-        else if (f->mode == SY_CLUSTER_COOPERATIVE) {
+        if (f->mode == SY_CLUSTER_COOPERATIVE) {
             r = sy_cluster_tile_decode(tl, &fc->accum[idx], tl->rect.x, tl->rect.y, err);
             if (!r) fc->accum_samples[idx] = t->samples;
         } else {
@@ -183,15 +242,16 @@ static void *conn_thread(void *p)
     frame_ctx *fc = a->fc;
     sy_cluster_client *c = fc->c;
     conn *k = &c->conns[a->conn];
-    sy_error err = {0};
+    sy_error err = {0}, ahead_err = {0};
     sy_result r = SY_OK;
-    if (a->send_scene && k->scene_msg.size) r = sy_clu_send_scene(c, k, &err);
+    if (a->send_scene && k->scene_msg.size) r = sy_clu_send_scene(c, k, &err); /* drops a stale answer first */
     for (uint32_t i = 0; r == SY_OK && i < fc->item_count; ++i) {
         work_item *it = &fc->items[i];
         if (it->owner != (int)a->conn || it->done) continue;
-        r = run_item(fc, k, a->conn, it, &err);
+        r = run_item(fc, k, a->conn, it, &ahead_err, &err);
         if (r == SY_OK) it->done = true;
     }
+    if (r == SY_OK && ahead_err.code) r = ahead_err.code, err = ahead_err; /* its answers count; dropped after */
     if (r) {
         a->failed = true;
         sy_clu_copy_str(k->error, sizeof k->error, err.message);
@@ -386,6 +446,63 @@ sy_result sy_clu_sync_servers(sy_cluster_client *c, uint64_t *scene_bytes, sy_er
     return r;
 }
 
+/* Cooperative pipelining, before the rounds: which servers' requests sent ahead are this frame's
+ * (byte for byte: the answer is used); when one is not (the frame asks otherwise: view, samples,
+ * parameters, servers), this frame's sample ranges start past those the stale requests took, so
+ * ranges never repeat on a server that kept the stale samples (same view), and every request sent
+ * ahead is dropped. Marks the servers with exactly one item (only they send ahead). */
+static sy_result coop_pipeline_plan(frame_ctx *fc, sy_error *err)
+{
+    sy_cluster_client *c = fc->c;
+    fc->ahead_hit = calloc(c->n, sizeof *fc->ahead_hit);
+    fc->single = calloc(c->n, sizeof *fc->single);
+    if (!fc->ahead_hit || !fc->single) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "cluster: out of memory");
+    uint32_t items[SY_CLUSTER_MAX_SERVERS] = {0};
+    uint32_t first = UINT32_MAX, end = 0;
+    for (uint32_t j = 0; j < fc->item_count; ++j) {
+        const work_item *it = &fc->items[j];
+        items[it->owner]++;
+        if (it->sample_first < first) first = it->sample_first;
+        if (it->sample_first + it->sample_count > end) end = it->sample_first + it->sample_count;
+    }
+    fc->coop_span = first < end ? end - first : 0;
+    bool any = false, all = true;
+    for (uint32_t i = 0; i < c->n; ++i) {
+        fc->single[i] = items[i] == 1;
+        any = any || c->conns[i].ahead.size;
+    }
+    fc->pipeline = !c->o.no_pipeline;
+    if (!any) return SY_OK;
+    sy_cluster_buf b = {0};
+    for (uint32_t j = 0; j < fc->item_count && all; ++j) {
+        const work_item *it = &fc->items[j];
+        conn *k = &c->conns[it->owner];
+        if (!k->ahead.size || !fc->single[it->owner]) continue;
+        sy_cluster_msg m;
+        make_render(fc, k, (uint32_t)it->owner, it, &m);
+        b.size = 0;
+        sy_result r = sy_cluster_encode(&m, 0, &b, err);
+        if (r) {
+            sy_cluster_buf_free(&b);
+            return r;
+        }
+        /* a SCENE goes first (the stale answer is dropped before it): not this frame's */
+        fc->ahead_hit[it->owner] = !k->scene_msg.size && b.size == k->ahead.size && !memcmp(b.data, k->ahead.data, b.size);
+    }
+    sy_cluster_buf_free(&b);
+    for (uint32_t i = 0; i < c->n; ++i) all = all && (!c->conns[i].ahead.size || fc->ahead_hit[i]);
+    if (all) return SY_OK;
+    memset(fc->ahead_hit, 0, c->n * sizeof *fc->ahead_hit); /* every answer sent ahead is stale */
+    if (c->coop_ahead_end > first && fc->coop_span) {
+        uint32_t shift = c->coop_ahead_end - first;
+        if (end > UINT32_MAX - SY_CLUSTER_MAX_SAMPLES - shift)
+            return sy_error_set(err, SY_ERR_LIMIT, "cluster: the cooperative sample index would overflow");
+        for (uint32_t j = 0; j < fc->item_count; ++j) fc->items[j].sample_first += shift;
+        c->coop_next = end + shift;
+    }
+    return SY_OK;
+}
+
 sy_result sy_cluster_client_render(sy_cluster_client *c, const sy_cluster_frame *f, sy_layer *out,
                                    sy_cluster_frame_stats *stats, sy_error *err)
 {
@@ -408,10 +525,11 @@ sy_result sy_cluster_client_render(sy_cluster_client *c, const sy_cluster_frame 
     }
     c->frame++;
     uint64_t sent0 = 0, recv0 = 0;
-    uint64_t blobf0 = 0, blobp0 = 0;
+    uint64_t blobf0 = 0, blobp0 = 0, used0 = 0, dropped0 = 0;
     for (uint32_t i = 0; i < c->n; ++i) {
         sent0 += c->conns[i].bytes_sent, recv0 += c->conns[i].bytes_received;
         blobf0 += c->conns[i].blob_frames_bytes, blobp0 += c->conns[i].blob_payload_bytes;
+        used0 += c->conns[i].ahead_used, dropped0 += c->conns[i].ahead_dropped;
     }
     sy_result r = sy_clu_sync_servers(c, &st.scene_bytes, err);
     if (r) return r;
@@ -509,6 +627,8 @@ sy_result sy_cluster_client_render(sy_cluster_client *c, const sy_cluster_frame 
         }
     }
     if (r == SY_OK && f->mode != SY_CLUSTER_MULTI_DISPLAY) r = split_large_items(&fc, err);
+    fc.first_items = fc.item_count;
+    if (r == SY_OK && f->mode == SY_CLUSTER_COOPERATIVE) r = coop_pipeline_plan(&fc, err);
     /* 4. rounds: scene + work, then failed work to the survivors, until done */
     bool first = true;
     for (uint32_t round = 0; r == SY_OK && round <= c->n; ++round) {
@@ -573,6 +693,8 @@ sy_result sy_cluster_client_render(sy_cluster_client *c, const sy_cluster_frame 
         st.bytes_received += c->conns[i].bytes_received;
         st.scene_bytes += c->conns[i].blob_frames_bytes;
         st.blob_bytes += c->conns[i].blob_payload_bytes;
+        st.pipelined += (uint32_t)c->conns[i].ahead_used;
+        st.stale += (uint32_t)c->conns[i].ahead_dropped;
         sy_blob_store_destroy(c->conns[i].offered); /* the frame's blobs are on the servers now */
         c->conns[i].offered = NULL;
     }
@@ -580,6 +702,13 @@ sy_result sy_cluster_client_render(sy_cluster_client *c, const sy_cluster_frame 
     st.bytes_received -= recv0;
     st.scene_bytes -= blobf0;
     st.blob_bytes -= blobp0;
+    st.pipelined -= (uint32_t)used0;
+    st.stale -= (uint32_t)dropped0;
+    /* the sample ranges the requests sent ahead took: a next frame that asks otherwise starts past them */
+    for (uint32_t i = 0; i < c->n; ++i)
+        if (c->conns[i].ahead.size) c->coop_ahead_end = c->coop_next + fc.coop_span;
+    free(fc.ahead_hit);
+    free(fc.single);
     free(fc.accum);
     free(fc.accum_samples);
     free(fc.items);

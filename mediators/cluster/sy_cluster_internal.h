@@ -252,6 +252,16 @@ typedef struct conn {
     uint32_t last_rows;
     uint64_t bytes_sent, bytes_received;
     char error[SY_ERROR_MESSAGE_MAX];
+    /* cooperative pipelining (sy_cluster_frame.c): at most one RENDER sent ahead, for the next
+     * frame, while this frame's answer is merged; its answer is used when the next frame asks the
+     * same, else received and dropped before anything else is sent (sy_clu_conn_drain) */
+    sy_cluster_buf ahead;        /* its encoding (untagged); size 0 = none in flight */
+    uint64_t ahead_frame;        /* the frame and job it names: its answer must name the same */
+    uint32_t ahead_job;
+    uint64_t ahead_used, ahead_dropped; /* answers to requests sent ahead: used / dropped, cumulative */
+    sy_cluster_buf last_req;     /* the last frame's RENDER with frame, sample_first and RESTART cleared
+                                    (size 0 = none): a frame that asks the same again is sent ahead */
+    uint64_t last_req_frame;
 } conn;
 
 struct sy_cluster_client {
@@ -262,6 +272,7 @@ struct sy_cluster_client {
     uint32_t n;
     uint64_t frame;
     uint32_t coop_next; /* cooperative: first sample index of the next frame (ranges never repeat) */
+    uint32_t coop_ahead_end; /* one past the last sample index a request sent ahead asked for */
     size_t max_frame, max_message;
     uint32_t timeout_ms, connect_timeout_ms;
     char *tls_ca; /* owned copy of the CA file path */
@@ -278,6 +289,18 @@ void sy_clu_conn_drop(sy_cluster_client *c, conn *k, const char *what, const cha
  * open). *reply borrows *raw (free it with free() after sy_cluster_msg_free). */
 sy_result sy_clu_conn_call(sy_cluster_client *c, conn *k, sy_cluster_msg *req, const sy_cluster_buf *preencoded,
                            uint32_t expect, sy_cluster_msg *reply, uint8_t **raw, sy_error *err);
+/* The reply to a request already sent: within timeout_ms from now / by the deadline (sy_time_now
+ * seconds); an ERROR or a type other than expect is an error. *reply borrows *raw as above. */
+sy_result sy_clu_conn_recv(sy_cluster_client *c, conn *k, uint32_t expect, sy_cluster_msg *reply, uint8_t **raw,
+                           sy_error *err);
+sy_result sy_clu_conn_recv_until(sy_cluster_client *c, conn *k, uint32_t expect, double deadline, sy_cluster_msg *reply,
+                                 uint8_t **raw, sy_error *err);
+/* Sends k->ahead (an encoded RENDER of `frame`, job `job`) without waiting for its answer; on
+ * failure k->ahead is cleared and the caller drops the connection. */
+sy_result sy_clu_conn_send_ahead(sy_cluster_client *c, conn *k, uint64_t frame, uint32_t job, sy_error *err);
+/* Receives and drops the answer owed to a request sent ahead (none: SY_OK at once). An answer that
+ * is not TILES for that frame and job is a protocol error (the caller drops the connection). */
+sy_result sy_clu_conn_drain(sy_cluster_client *c, conn *k, sy_error *err);
 sy_result sy_clu_conn_connect(sy_cluster_client *c, conn *k, sy_error *err); /* dial + handshake */
 
 /* sy_cluster_frame.c */

@@ -50,6 +50,7 @@ typedef struct fixture {
 static sy_cluster_client *connect_all(fixture *fx, server *s, uint32_t n, const char *secret, uint32_t timeout_ms,
                                       sy_error *e);
 static sy_cluster_frame make_frame(fixture *fx, uint32_t mode, const char *backend, const sy_camera_view *view);
+static bool same_region(const sy_layer *a, uint32_t ax, const sy_layer *b, uint32_t w, uint32_t h);
 
 static int local_render_spp(fixture *fx, const char *backend, uint32_t eye, uint32_t spp, uint32_t seed, sy_layer *out,
                             sy_camera_view *view)
@@ -161,8 +162,33 @@ static int test_cooperative_pathtracer(fixture *fx, server *s)
     double ec2 = rms_diff(&out, &ref);
     printf("cooperative pathtracer: second frame %llu samples, rms error %.5f\n", (unsigned long long)st.samples, ec2);
     CHECK(st.samples == 32 && ec2 < ec);
+    /* pipelining keeps every merged image what it was (issue 39): a client that never sends ahead
+     * renders the same frames on the same servers bit for bit, the third (pipelined here) and one
+     * after a camera move, for which this client drops its answers of the old view */
+    const char *urls[2] = {s[0].url, s[1].url};
+    sy_cluster_client_opts co = {.urls = urls, .url_count = 2, .secret = (const uint8_t *)"s3cret", .secret_len = 6,
+                                 .timeout_ms = 60000, .connect_timeout_ms = 3000, .no_pipeline = true};
+    sy_cluster_client *c2 = NULL;
+    sy_layer o2 = {0};
+    sy_cluster_frame_stats s2;
+    CHECK_OK(sy_cluster_client_create(fx->scene, &co, &c2, &e), e);
+    CHECK_OK(sy_layer_create(fx->w, fx->h, &o2, &e), e);
+    for (int i = 0; i < 3; ++i) CHECK_OK(sy_cluster_client_render(c2, &f, &o2, &s2, &e), e);
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, &st, &e), e);
+    CHECK_MSG(st.pipelined == 2 && st.samples == 48 && s2.pipelined == 0 && s2.samples == 48,
+              "frame 3: %u / %u answers requested ahead, %llu / %llu samples", st.pipelined, s2.pipelined,
+              (unsigned long long)st.samples, (unsigned long long)s2.samples);
+    CHECK_MSG(same_region(&out, 0, &o2, fx->w, fx->h), "pipelined frame 3 differs from the one without pipelining");
+    f.camera.camera_to_world.m[12] += 0.05f;
+    CHECK_OK(sy_cluster_client_render(c2, &f, &o2, &s2, &e), e);
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, &st, &e), e);
+    CHECK_MSG(st.stale == 2 && st.pipelined == 0 && st.samples == 16 && s2.samples == 16,
+              "after the move: %u stale answers, %llu / %llu samples", st.stale, (unsigned long long)st.samples,
+              (unsigned long long)s2.samples);
+    CHECK_MSG(same_region(&out, 0, &o2, fx->w, fx->h), "the frame after a move differs from the one without pipelining");
+    sy_cluster_client_destroy(c2);
     sy_cluster_client_destroy(c);
-    DESTROY_LAYERS(&ref, &l8, &l16, &out);
+    DESTROY_LAYERS(&ref, &l8, &l16, &out, &o2);
     return 0;
 }
 
@@ -281,6 +307,42 @@ static int test_sort_first_balanced_stereo(fixture *fx, server *s)
     return 0;
 }
 
+/* $COOP_DOUBLE_TRACE of the servers (set in main): the requests their "coop_test" contexts got */
+static char g_coop_trace[600];
+
+/* Whether the trace file holds the line (waits for it: 60 s, a hang guard). */
+static bool trace_has(const char *path, const char *line)
+{
+    for (int i = 0; i < 1200; ++i) {
+        FILE *f = fopen(path, "r");
+        if (f) {
+            static char buf[1 << 16];
+            size_t n = fread(buf, 1, sizeof buf - 1, f);
+            fclose(f);
+            buf[n] = 0;
+            for (const char *p = buf; (p = strstr(p, line)) != NULL; ++p)
+                if (p == buf || p[-1] == '\n') return true;
+        }
+        sleep_ms(50);
+    }
+    return false;
+}
+
+/* Largest difference of out's red channel (every step-th pixel) from the mean of the double's
+ * samples first .. first + n - 1. */
+static double coop_merge_error(const fixture *fx, const sy_layer *out, uint32_t first, uint32_t n, uint32_t step)
+{
+    double maxerr = 0;
+    for (uint32_t y = 0; y < fx->h; y += step)
+        for (uint32_t x = 0; x < fx->w; x += step) {
+            double sum = 0;
+            for (uint32_t k = 0; k < n; ++k) sum += coop_double_sample(x, y, first + k);
+            double d = fabs(out->rgba[((size_t)y * fx->w + x) * 4] - sum / n);
+            if (d > maxerr) maxerr = d;
+        }
+    return maxerr;
+}
+
 static int test_cooperative(fixture *fx, server *s)
 {
     sy_error e = {0};
@@ -312,6 +374,27 @@ static int test_cooperative(fixture *fx, server *s)
             if (d > maxerr) maxerr = d;
         }
     CHECK_MSG(maxerr < 1e-6, "second cooperative frame off by %g", maxerr);
+    CHECK(st.pipelined == 0 && st.stale == 0);
+    /* pipelining (issue 39): frame 2 asked what frame 1 asked, so each server got frame 3's request
+     * (samples 32..39 and 40..47) as soon as its frame-2 answer was in, before the client merged
+     * frame 2: the servers render them before frame 3 is even asked for */
+    CHECK_MSG(trace_has(g_coop_trace, "32 8\n") && trace_has(g_coop_trace, "40 8\n"),
+              "the servers never got frame 3's requests ahead of the call (trace %s)", g_coop_trace);
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, &st, &e), e);
+    CHECK_MSG(st.samples == 48 && st.pipelined == 2 && st.stale == 0, "frame 3: %llu samples, %u answers requested ahead, %u stale",
+              (unsigned long long)st.samples, st.pipelined, st.stale);
+    CHECK_MSG(coop_merge_error(fx, &out, 0, 48, 1) < 1e-6, "third (pipelined) cooperative frame off by %g",
+              coop_merge_error(fx, &out, 0, 48, 1));
+    /* a frame that asks otherwise (4 samples a server): the answers to frame 4's requests sent ahead
+     * (samples 48..63) are dropped, never merged, and the new ranges start past them (64..71): the
+     * double keeps every sample it drew (it never restarts, as a path tracer at an unchanged view),
+     * so the merged image is the exact mean of 72 distinct samples */
+    f.samples = 4;
+    CHECK_OK(sy_cluster_client_render(c, &f, &out, &st, &e), e);
+    CHECK_MSG(st.samples == 72 && st.pipelined == 0 && st.stale == 2, "frame 4: %llu samples, %u answers requested ahead, %u stale",
+              (unsigned long long)st.samples, st.pipelined, st.stale);
+    CHECK_MSG(coop_merge_error(fx, &out, 0, 72, 1) < 1e-6, "frame after the stale answers off by %g",
+              coop_merge_error(fx, &out, 0, 72, 1));
     sy_cluster_client_destroy(c);
     sy_layer_destroy(&out);
     return 0;
@@ -964,6 +1047,9 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s\n", e.message);
         return 1;
     }
+    snprintf(g_coop_trace, sizeof g_coop_trace, "%s/coop_trace.txt", g_dir);
+    unlink(g_coop_trace);
+    setenv("COOP_DOUBLE_TRACE", g_coop_trace, 1); /* the servers' "coop_test" contexts log their requests */
     server s[4];
     memset(s, 0, sizeof s);
     int failed = 0;
