@@ -41,12 +41,12 @@ typedef struct coop_run {
  * 4-sample frame so that a frame takes about frame_s on one server, and returned for the other
  * runs. */
 static sy_result coop_measure(sy_scene *scene, const sy_viewport_desc *vd, const sy_bench_cluster_server *srv, uint32_t n,
-                              uint32_t w, uint32_t h, uint32_t *spf, double frame_s, double min_seconds, coop_run *out,
-                              sy_error *err)
+                              uint32_t w, uint32_t h, uint32_t *spf, double frame_s, double min_seconds, bool no_pipeline,
+                              coop_run *out, sy_error *err)
 {
     memset(out, 0, sizeof *out);
     const char *urls[2] = {srv[0].url, n > 1 ? srv[1].url : NULL};
-    sy_cluster_client_opts co = {.urls = urls, .url_count = n, .timeout_ms = 120000};
+    sy_cluster_client_opts co = {.urls = urls, .url_count = n, .timeout_ms = 120000, .no_pipeline = no_pipeline};
     sy_bench_cluster_rig rig;
     sy_result r = sy_bench_cluster_rig_open(scene, vd, &co, w, h, &rig, err);
     sy_cluster_frame f = {.mode = SY_CLUSTER_COOPERATIVE, .backend = "pathtracer", .root_id = vd->root.id,
@@ -96,7 +96,7 @@ static sy_result coop_measure(sy_scene *scene, const sy_viewport_desc *vd, const
  * the wall-clock ratio drops, while samples per server CPU-second (the cost of cooperating: the
  * sample split, transfers, merging, waiting for the other server) stay comparable. */
 sy_result sy_bench_cluster_coop(sy_scene *scene, const sy_viewport_desc *vd, const sy_bench_cluster_server *srv,
-                                uint32_t rounds, bool pinned, double frame_s, sy_error *err)
+                                uint32_t rounds, bool pinned, double frame_s, bool no_pipeline, sy_error *err)
 {
     const uint32_t w = 320, h = 180;
     const double min_seconds = frame_s * 3.75 > 1.5 ? frame_s * 3.75 : 1.5;
@@ -107,13 +107,14 @@ sy_result sy_bench_cluster_coop(sy_scene *scene, const sy_viewport_desc *vd, con
     if (rounds > MAX_ROUNDS) rounds = MAX_ROUNDS;
     sy_result r = SY_OK;
     printf("  cooperative pathtracer %ux%u, servers %s, %u interleaved rounds of >= %.1f s per side, frames of about "
-           "%.2f s on one server:\n",
-           w, h, pinned ? "pinned to cores 0 and 1" : "not pinned (1 core)", rounds, min_seconds, frame_s);
+           "%.2f s on one server, %s:\n",
+           w, h, pinned ? "pinned to cores 0 and 1" : "not pinned (1 core)", rounds, min_seconds, frame_s,
+           no_pipeline ? "not pipelined (--coop-no-pipeline)" : "pipelined");
     for (uint32_t round = 0; round < rounds && r == SY_OK; ++round) {
         coop_run run[2];
         for (uint32_t k = 0; k < 2 && r == SY_OK; ++k) {
             uint32_t n = (round & 1) ? 2 - k : 1 + k; /* 1,2 / 2,1 / 1,2 ... */
-            r = coop_measure(scene, vd, srv, n, w, h, &spf, frame_s, min_seconds, &run[n - 1], err);
+            r = coop_measure(scene, vd, srv, n, w, h, &spf, frame_s, min_seconds, no_pipeline, &run[n - 1], err);
         }
         if (r != SY_OK) break;
         rate[0][nr] = run[0].rate, rate[1][nr] = run[1].rate;
