@@ -29,6 +29,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <netinet/in.h>
+#include <poll.h>
 #include <pthread.h>
 #include <signal.h>
 #include <stdlib.h>
@@ -397,6 +398,183 @@ static int test_cooperative(fixture *fx, server *s)
               coop_merge_error(fx, &out, 0, 72, 1));
     sy_cluster_client_destroy(c);
     sy_layer_destroy(&out);
+    return 0;
+}
+
+/* ---- a fake render server for the pipelining tests: answers like a server (no secret, loopback),
+ * with flat tiles, and misbehaves on the request of frame 3 as its mode says ---- */
+enum { FAKE_TWICE = 1, FAKE_WRONG_ROUND = 2, FAKE_LATE = 3 };
+typedef struct fake_server {
+    int listen_fd, port, mode, late_ms;
+    pthread_t th;
+} fake_server;
+
+static void *fake_main(void *p)
+{
+    fake_server *fs = p;
+    struct pollfd pfd = {fs->listen_fd, POLLIN, 0};
+    if (poll(&pfd, 1, 30000) != 1) return NULL; /* fake_stop closes the listening socket */
+    int fd = accept(fs->listen_fd, NULL, NULL);
+    close(fs->listen_fd); /* one connection: a redial is refused at once */
+    fs->listen_fd = -1;
+    if (fd < 0) return NULL;
+    struct timeval tv = {30, 0};
+    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+    setsockopt(fd, SOL_SOCKET, SO_SNDTIMEO, &tv, sizeof tv);
+    uint64_t seq = 0, samples = 0;
+    sy_layer l = {0};
+    sy_cluster_buf enc = {0};
+    sy_error e = {0};
+    for (;;) {
+        sy_cluster_msg m, rep;
+        uint8_t *raw = NULL;
+        if (raw_recv_msg(fd, 1u << 26, &m, &raw) != 0) break;
+        memset(&rep, 0, sizeof rep);
+        bool twice = false;
+        if (m.header.type == SY_CLUSTER_HELLO) {
+            rep.header.type = SY_CLUSTER_CHALLENGE; /* no secret: the session is open */
+            rep.u.hello.max_frame = SY_CLUSTER_DEFAULT_MAX_FRAME;
+            rep.u.hello.max_message = SY_CLUSTER_DEFAULT_MAX_MESSAGE;
+            snprintf(rep.u.hello.name, sizeof rep.u.hello.name, "fake");
+        } else if (m.header.type == SY_CLUSTER_SCENE) {
+            rep.header.type = SY_CLUSTER_SCENE_ACK;
+            rep.u.ack.frame = m.u.scene.frame;
+        } else if (m.header.type == SY_CLUSTER_RENDER && m.u.render.tile_count == 1) {
+            const sy_cluster_rect *r = &m.u.render.tiles[0];
+            sy_layer_destroy(&l);
+            enc.size = 0;
+            if (sy_layer_create(r->w, r->h, &l, &e) != SY_OK) break;
+            for (size_t i = 0; i < (size_t)r->w * r->h * 4; ++i) l.rgba[i] = 0.5f;
+            for (size_t i = 0; i < (size_t)r->w * r->h; ++i) l.depth[i] = 2.0f;
+            if (sy_cluster_tile_encode(&l, true, &enc, &e) != SY_OK) break;
+            samples += m.u.render.sample_count;
+            sy_cluster_tile t = {*r, SY_CLUSTER_ENC_F32_SHUFFLE_ZSTD, 5, (uint64_t)r->w * r->h * 5 * 4, enc.data,
+                                 (uint32_t)enc.size};
+            rep.header.type = SY_CLUSTER_TILES;
+            rep.u.tiles.frame = m.u.render.frame;
+            rep.u.tiles.job = m.u.render.job;
+            rep.u.tiles.samples = samples;
+            rep.u.tiles.tile_count = 1;
+            rep.u.tiles.tiles = &t;
+            if (m.u.render.frame == 3) {
+                twice = fs->mode == FAKE_TWICE;
+                if (fs->mode == FAKE_WRONG_ROUND) rep.u.tiles.frame = 99;
+                if (fs->mode == FAKE_LATE) sleep_ms(fs->late_ms);
+            }
+            rep.header.seq = ++seq;
+            int rc = raw_send_msg(fd, &rep);
+            if (rc == 0 && twice) {
+                rep.header.seq = ++seq;
+                rc = raw_send_msg(fd, &rep);
+            }
+            sy_cluster_msg_free(&m);
+            free(raw);
+            if (rc) break;
+            continue;
+        } else if (m.header.type == SY_CLUSTER_BYE) {
+            rep.header.type = SY_CLUSTER_BYE;
+        } else {
+            sy_cluster_msg_free(&m);
+            free(raw);
+            break;
+        }
+        bool bye = m.header.type == SY_CLUSTER_BYE;
+        sy_cluster_msg_free(&m);
+        free(raw);
+        rep.header.seq = ++seq;
+        if (raw_send_msg(fd, &rep) || bye) break;
+    }
+    sy_layer_destroy(&l);
+    sy_cluster_buf_free(&enc);
+    close(fd);
+    return NULL;
+}
+
+static int fake_start(fake_server *fs, int mode, int late_ms)
+{
+    memset(fs, 0, sizeof *fs);
+    fs->mode = mode;
+    fs->late_ms = late_ms;
+    fs->listen_fd = socket(AF_INET, SOCK_STREAM, 0);
+    struct sockaddr_in a = {.sin_family = AF_INET, .sin_addr.s_addr = htonl(INADDR_LOOPBACK)};
+    socklen_t len = sizeof a;
+    CHECK(fs->listen_fd >= 0 && bind(fs->listen_fd, (struct sockaddr *)&a, sizeof a) == 0 && listen(fs->listen_fd, 4) == 0 &&
+          getsockname(fs->listen_fd, (struct sockaddr *)&a, &len) == 0);
+    fs->port = ntohs(a.sin_port);
+    CHECK(pthread_create(&fs->th, NULL, fake_main, fs) == 0);
+    return 0;
+}
+
+static void fake_stop(fake_server *fs)
+{
+    pthread_join(fs->th, NULL);
+    if (fs->listen_fd >= 0) close(fs->listen_fd);
+}
+
+typedef struct log_capture {
+    pthread_mutex_t lock;
+    char text[8192];
+} log_capture;
+
+static void capture_line(void *user, const char *line)
+{
+    log_capture *lc = user;
+    pthread_mutex_lock(&lc->lock);
+    size_t n = strlen(lc->text);
+    snprintf(lc->text + n, sizeof lc->text - n, "%s\n", line);
+    pthread_mutex_unlock(&lc->lock);
+}
+
+/* Bad peers under pipelining (issue 39): a server that answers the request sent ahead twice, with
+ * a round it was not asked for, or past the deadline is dropped with the reason logged, as without
+ * pipelining, and the frame still comes back whole from the good server (s, no secret). */
+static int test_pipeline_bad_peers(fixture *fx, server *all)
+{
+    server *good = &all[3];
+    static const struct {
+        int mode;
+        const char *why;
+        uint32_t fails_in; /* the frame in which the fake is dropped */
+    } cases[] = {{FAKE_TWICE, "reply for frame 3 job 1 with 1 tiles does not match the request", 4},
+                 {FAKE_WRONG_ROUND, "reply for frame 99 job 1 with 1 tiles does not match the request", 3},
+                 {FAKE_LATE, "no reply before the deadline", 3}};
+    sy_camera_view view = sy_camera_view_frame_bounds(&(sy_bounds){{-1, -1, -1}, {1, 1, 1}}, 1.0f);
+    for (size_t ci = 0; ci < sizeof cases / sizeof cases[0]; ++ci) {
+        fake_server fs;
+        if (fake_start(&fs, cases[ci].mode, 2500)) return 1;
+        char fake_url[64];
+        snprintf(fake_url, sizeof fake_url, "tcp://127.0.0.1:%d", fs.port);
+        const char *urls[2] = {good->url, fake_url};
+        static log_capture lc = {PTHREAD_MUTEX_INITIALIZER, ""};
+        lc.text[0] = 0;
+        sy_cluster_client_opts co = {.urls = urls, .url_count = 2, .timeout_ms = 1000, .connect_timeout_ms = 3000,
+                                     .log = capture_line, .log_user = &lc};
+        sy_cluster_client *c = NULL;
+        sy_error e = {0};
+        CHECK_OK(sy_cluster_client_create(fx->scene, &co, &c, &e), e);
+        sy_cluster_frame f = make_frame(fx, SY_CLUSTER_COOPERATIVE, "coop_test", &view);
+        f.samples = 4;
+        sy_layer out = {0};
+        CHECK_OK(sy_layer_create(fx->w, fx->h, &out, &e), e);
+        for (uint32_t frame = 1; frame <= 4; ++frame) {
+            sy_cluster_frame_stats st;
+            sy_cluster_client_set_timeout(c, frame == 1 ? 30000 : 1000); /* the first: snapshot + translation */
+            CHECK_OK(sy_cluster_client_render(c, &f, &out, &st, &e), e);
+            bool dropped_now = frame == cases[ci].fails_in;
+            CHECK_MSG(st.servers_failed == (dropped_now ? 1u : 0u),
+                      "mode %d frame %u: %u servers failed", cases[ci].mode, frame, st.servers_failed);
+            CHECK_MSG(st.servers_live == (frame < cases[ci].fails_in ? 2u : 1u) || frame > cases[ci].fails_in,
+                      "mode %d frame %u: %u servers live", cases[ci].mode, frame, st.servers_live);
+            if (frame == 3) CHECK_MSG(st.pipelined >= 1, "mode %d: frame 3 used no answer requested ahead", cases[ci].mode);
+        }
+        pthread_mutex_lock(&lc.lock);
+        bool logged = strstr(lc.text, cases[ci].why) != NULL;
+        pthread_mutex_unlock(&lc.lock);
+        CHECK_MSG(logged, "mode %d: the log does not say '%s':\n%s", cases[ci].mode, cases[ci].why, lc.text);
+        sy_cluster_client_destroy(c);
+        sy_layer_destroy(&out);
+        fake_stop(&fs);
+    }
     return 0;
 }
 
@@ -1066,7 +1244,8 @@ int main(int argc, char **argv)
             {"bad messages", test_bad_messages}, {"blob cache", test_blob_cache}, {"blob eviction", test_blob_eviction},
             {"blob requests", test_blob_requests}, {"half tiles", test_half_tiles},
             {"replica slot limit", test_slot_limit}, {"several clients", test_several_clients},
-            {"authentication back-off", test_auth_backoff}, {"chunked transfers", test_chunked}, {"faults", test_faults}};
+            {"authentication back-off", test_auth_backoff}, {"chunked transfers", test_chunked}, {"faults", test_faults},
+            {"pipelining beside bad peers", test_pipeline_bad_peers}};
         for (size_t i = 0; i < sizeof tests / sizeof tests[0]; ++i) {
             int r = tests[i].run(&fx, s);
             failed += r;
