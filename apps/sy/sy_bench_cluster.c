@@ -79,11 +79,12 @@ int sy_cmd_bench_cluster(int argc, char **argv)
     uint32_t soak_s = 0, warmup_s = UINT32_MAX; /* --soak: seconds of camera changes against one server; --warmup: none given */
     const char *soak_backend = NULL;
     static const char usage_text[] = "usage: sy bench cluster [-w W] [-h H] [--repeats ROUNDS] [--hostile-only | --coop-only] "
-                                     "[--coop-frame SECONDS] [--coop-no-pipeline] | --scale\n"
+                                     "[--coop-frame SECONDS] [--coop-no-pipeline | --coop-ab] | --scale\n"
                                      "       sy bench cluster --soak SECONDS [--warmup SECONDS] [-b BACKEND] [-w W] [-h H]"
                                      "   (exit 1 unless every frame came back and the server's RSS, fds and threads grew < 5 %)\n";
-    enum { O_REPEATS = OPT_OWN_FIRST, O_HOSTILE, O_COOP, O_SCALE, O_COOP_FRAME, O_SOAK, O_WARMUP, O_COOP_NO_PIPE };
+    enum { O_REPEATS = OPT_OWN_FIRST, O_HOSTILE, O_COOP, O_SCALE, O_COOP_FRAME, O_SOAK, O_WARMUP, O_COOP_NO_PIPE, O_COOP_AB };
     bool coop_no_pipeline = false; /* cooperative: each frame's requests only once it is asked for (as before issue 39) */
+    bool coop_ab = false;          /* cooperative: pipelined and not, alternating in every round */
     const sy_cli_opt opts[] = {
         SY_CLI_OPT_UINT("repeats", O_REPEATS, &rounds, 1, 100),
         SY_CLI_OPT_FLAG("hostile-only", O_HOSTILE, &hostile_only),
@@ -95,6 +96,7 @@ int sy_cmd_bench_cluster(int argc, char **argv)
         SY_CLI_OPT_TEXT(NULL, 'b', &soak_backend),
         SY_CLI_OPT_REAL("coop-frame", O_COOP_FRAME, &coop_frame, 0.05, 60),
         SY_CLI_OPT_FLAG("coop-no-pipeline", O_COOP_NO_PIPE, &coop_no_pipeline),
+        SY_CLI_OPT_FLAG("coop-ab", O_COOP_AB, &coop_ab),
     };
     sy_cli_parser p = {SY_CLI_ARGS("bench cluster", argc, argv, opts), .w = &w, .h = &h, .min_size = 1, .usage = usage_text};
     if (sy_cli_parse(&p) != -1) return p.status;
@@ -102,6 +104,7 @@ int sy_cmd_bench_cluster(int argc, char **argv)
         fprintf(stderr, "sy bench cluster: error: unexpected argument '%s'\n%s", argv[optind], usage_text);
         return 2;
     }
+    int coop_pipe = coop_ab ? SY_BENCH_COOP_AB : coop_no_pipeline ? SY_BENCH_COOP_NOT_PIPELINED : SY_BENCH_COOP_PIPELINED;
     bool size_given = w || h;
     if (!w) w = 1920;
     if (!h) h = 1080;
@@ -177,7 +180,7 @@ int sy_cmd_bench_cluster(int argc, char **argv)
     sy_viewport_desc vd = {.root = d.root, .camera = d.camera, .background = d.background, .backend = backend};
     if (r == SY_OK && coop_only) {
         printf("sy bench cluster --coop-only: demo scene, 2 servers on loopback\n");
-        r = sy_bench_cluster_coop(scene, &vd, srv, rounds, ncpu >= 2, coop_frame, coop_no_pipeline, &err);
+        r = sy_bench_cluster_coop(scene, &vd, srv, rounds, ncpu >= 2, coop_frame, coop_pipe, &err);
         sy_bench_cluster_stop(&srv[0]);
         sy_bench_cluster_stop(&srv[1]);
         sy_scene_destroy(scene);
@@ -267,7 +270,7 @@ int sy_cmd_bench_cluster(int argc, char **argv)
     sy_bench_cluster_rig_close(&rig);
     /* cooperative path tracing: 2 pinned servers vs 1 */
     if (r == SY_OK && sy_mediator_find("pathtracer")) {
-        r = sy_bench_cluster_coop(scene, &vd, srv, rounds, ncpu >= 2, coop_frame, coop_no_pipeline, &err);
+        r = sy_bench_cluster_coop(scene, &vd, srv, rounds, ncpu >= 2, coop_frame, coop_pipe, &err);
     } else if (r == SY_OK) {
         printf("  cooperative: skipped (no 'pathtracer' back-end registered in this build)\n");
     }

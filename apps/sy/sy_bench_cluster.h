@@ -49,10 +49,11 @@ sy_result sy_bench_cluster_rig_open(sy_scene *scene, const sy_viewport_desc *vd,
 void sy_bench_cluster_rig_close(sy_bench_cluster_rig *rig);
 
 /* Cooperative path tracing, 2 servers (srv[0], srv[1]; pinned: to cores 0 and 1) vs 1 in `rounds`
- * interleaved rounds, frames of about frame_s seconds on one server, pipelined unless no_pipeline
- * (sy_bench_cluster_coop.c). */
+ * interleaved rounds, frames of about frame_s seconds on one server; pipe: pipelined, not, or both
+ * alternating (sy_bench_cluster_coop.c). */
+enum { SY_BENCH_COOP_PIPELINED = 0, SY_BENCH_COOP_NOT_PIPELINED = 1, SY_BENCH_COOP_AB = 2 };
 sy_result sy_bench_cluster_coop(sy_scene *scene, const sy_viewport_desc *vd, const sy_bench_cluster_server *srv,
-                                uint32_t rounds, bool pinned, double frame_s, bool no_pipeline, sy_error *err);
+                                uint32_t rounds, bool pinned, double frame_s, int pipe, sy_error *err);
 /* Server srv's memory and a client's frame time under 64 tricklers + 8 flooders that never
  * authenticate (sy_bench_cluster_hostile.c). */
 sy_result sy_bench_cluster_hostile(sy_scene *scene, const sy_demo_info *d, const char *backend,

@@ -91,56 +91,82 @@ static sy_result coop_measure(sy_scene *scene, const sy_viewport_desc *vd, const
 
 /* Cooperative path tracing, 2 servers pinned to one core each vs 1 server: `rounds` interleaved
  * rounds (the order alternates, so a drift in the machine's load hits both sides alike); the
- * speed-up is best 2-server rate / best 1-server rate, each round's ratio printed beside it.
- * Each server's CPU time shows how much of its core it got: on a machine shared with other work
- * the wall-clock ratio drops, while samples per server CPU-second (the cost of cooperating: the
- * sample split, transfers, merging, waiting for the other server) stay comparable. */
+ * speed-up is the median of the rounds' 2-server rate / 1-server rate, each round's ratio printed
+ * beside it. Each server's CPU time shows how much of its core it got: on a machine shared with
+ * other work the wall-clock ratio drops, while samples per server CPU-second (the cost of
+ * cooperating: the sample split, transfers, merging, waiting for the other server) stay
+ * comparable. pipe: SY_BENCH_COOP_PIPELINED, _NOT_PIPELINED (--coop-no-pipeline), or _AB
+ * (--coop-ab: both in every round, their order alternating too, and the pipelined rate over the
+ * other per server count). */
 sy_result sy_bench_cluster_coop(sy_scene *scene, const sy_viewport_desc *vd, const sy_bench_cluster_server *srv,
-                                uint32_t rounds, bool pinned, double frame_s, bool no_pipeline, sy_error *err)
+                                uint32_t rounds, bool pinned, double frame_s, int pipe, sy_error *err)
 {
     const uint32_t w = 320, h = 180;
     const double min_seconds = frame_s * 3.75 > 1.5 ? frame_s * 3.75 : 1.5;
     uint32_t spf = 0;
     enum { MAX_ROUNDS = 64 };
-    double ratio[MAX_ROUNDS], rate[2][MAX_ROUNDS], eff[2][MAX_ROUNDS]; /* per round: speed-up, spp/s, spp per CPU-s */
-    uint32_t nr = 0, ne = 0;
+    /* per variant (0 pipelined, 1 not) and round: speed-up, spp/s (1 / 2 servers), spp per CPU-s */
+    double ratio[2][MAX_ROUNDS], rate[2][2][MAX_ROUNDS], eff[2][2][MAX_ROUNDS], gain[2][MAX_ROUNDS];
+    uint32_t nr = 0, ne[2] = {0, 0};
     if (rounds > MAX_ROUNDS) rounds = MAX_ROUNDS;
+    bool ab = pipe == SY_BENCH_COOP_AB;
+    uint32_t nv = ab ? 2 : 1, v0 = pipe == SY_BENCH_COOP_NOT_PIPELINED ? 1 : 0;
+    static const char *vname[2] = {"pipelined", "not pipelined"};
     sy_result r = SY_OK;
     printf("  cooperative pathtracer %ux%u, servers %s, %u interleaved rounds of >= %.1f s per side, frames of about "
            "%.2f s on one server, %s:\n",
            w, h, pinned ? "pinned to cores 0 and 1" : "not pinned (1 core)", rounds, min_seconds, frame_s,
-           no_pipeline ? "not pipelined (--coop-no-pipeline)" : "pipelined");
+           ab ? "pipelined and not (--coop-ab, alternating)" : v0 ? "not pipelined (--coop-no-pipeline)" : "pipelined");
     for (uint32_t round = 0; round < rounds && r == SY_OK; ++round) {
-        coop_run run[2];
-        for (uint32_t k = 0; k < 2 && r == SY_OK; ++k) {
-            uint32_t n = (round & 1) ? 2 - k : 1 + k; /* 1,2 / 2,1 / 1,2 ... */
-            r = coop_measure(scene, vd, srv, n, w, h, &spf, frame_s, min_seconds, no_pipeline, &run[n - 1], err);
+        coop_run run[2][2];
+        for (uint32_t j = 0; j < nv && r == SY_OK; ++j) {
+            uint32_t v = ab ? ((round >> 1 & 1) ? 1 - j : j) : v0; /* A B / A B / B A / B A ... */
+            for (uint32_t k = 0; k < 2 && r == SY_OK; ++k) {
+                uint32_t n = (round & 1) ? 2 - k : 1 + k; /* 1,2 / 2,1 / 1,2 ... */
+                r = coop_measure(scene, vd, srv, n, w, h, &spf, frame_s, min_seconds, v == 1, &run[v][n - 1], err);
+            }
         }
         if (r != SY_OK) break;
-        rate[0][nr] = run[0].rate, rate[1][nr] = run[1].rate;
-        ratio[nr++] = run[0].rate > 0 ? run[1].rate / run[0].rate : 0.0;
-        double cpu1 = run[0].cpu[0], cpu2 = run[1].cpu[0] + run[1].cpu[1];
-        if (run[0].cpu[0] >= 0 && run[1].cpu[0] >= 0 && run[1].cpu[1] >= 0 && cpu1 > 0 && cpu2 > 0) {
-            eff[0][ne] = (double)run[0].samples / cpu1, eff[1][ne] = (double)run[1].samples / cpu2;
-            ne++;
+        for (uint32_t j = 0; j < nv; ++j) {
+            uint32_t v = ab ? j : v0;
+            coop_run *rv = run[v];
+            rate[v][0][nr] = rv[0].rate, rate[v][1][nr] = rv[1].rate;
+            ratio[v][nr] = rv[0].rate > 0 ? rv[1].rate / rv[0].rate : 0.0;
+            double cpu1 = rv[0].cpu[0], cpu2 = rv[1].cpu[0] + rv[1].cpu[1];
+            if (rv[0].cpu[0] >= 0 && rv[1].cpu[0] >= 0 && rv[1].cpu[1] >= 0 && cpu1 > 0 && cpu2 > 0) {
+                eff[v][0][ne[v]] = (double)rv[0].samples / cpu1, eff[v][1][ne[v]] = (double)rv[1].samples / cpu2;
+                ne[v]++;
+            }
+            printf("    round %u%s%s (%u spp per server and frame): 1 server %.1f spp/s (busy %.2f s CPU of %.2f s); "
+                   "2 servers %.1f spp/s (busy %.2f + %.2f s CPU of %.2f s): %.2fx; answers requested ahead %u/%u\n",
+                   round + 1, ab ? ", " : "", ab ? vname[v] : "", spf, rv[0].rate, rv[0].cpu[0], rv[0].seconds, rv[1].rate,
+                   rv[1].cpu[0], rv[1].cpu[1], rv[1].seconds, ratio[v][nr], rv[0].pipelined + rv[1].pipelined,
+                   rv[0].answers + rv[1].answers);
         }
-        printf("    round %u (%u spp per server and frame): 1 server %.1f spp/s (busy %.2f s CPU of %.2f s); "
-               "2 servers %.1f spp/s (busy %.2f + %.2f s CPU of %.2f s): %.2fx; answers requested ahead %u/%u\n",
-               round + 1, spf, run[0].rate, run[0].cpu[0], run[0].seconds, run[1].rate, run[1].cpu[0], run[1].cpu[1],
-               run[1].seconds, ratio[nr - 1], run[0].pipelined + run[1].pipelined, run[0].answers + run[1].answers);
+        if (ab)
+            for (uint32_t n = 0; n < 2; ++n) gain[n][nr] = run[1][n].rate > 0 ? run[0][n].rate / run[1][n].rate : 0.0;
+        nr++;
     }
-    if (r == SY_OK && nr) {
-        sy_bench_spread sr = sy_bench_spread_of(ratio, nr), s1 = sy_bench_spread_of(rate[0], nr),
-                        s2 = sy_bench_spread_of(rate[1], nr);
-        printf("  cooperative speed-up (median of %u rounds, min..max): %.2fx (%.2f..%.2f; target >= 1.95x); "
+    for (uint32_t j = 0; j < nv && r == SY_OK && nr; ++j) {
+        uint32_t v = ab ? j : v0;
+        sy_bench_spread sr = sy_bench_spread_of(ratio[v], nr), s1 = sy_bench_spread_of(rate[v][0], nr),
+                        s2 = sy_bench_spread_of(rate[v][1], nr);
+        printf("  cooperative speed-up%s%s (median of %u rounds, min..max): %.2fx (%.2f..%.2f; target >= 1.95x); "
                "1 server %.1f spp/s, 2 servers %.1f spp/s (medians)\n",
-               nr, sr.median, sr.min, sr.max, s1.median, s2.median);
+               ab ? ", " : "", ab ? vname[v] : "", nr, sr.median, sr.min, sr.max, s1.median, s2.median);
+        if (ne[v]) {
+            sy_bench_spread e1 = sy_bench_spread_of(eff[v][0], ne[v]), e2 = sy_bench_spread_of(eff[v][1], ne[v]);
+            printf("  per server CPU-second%s%s (median of %u): 1 server %.1f spp, 2 servers %.1f spp (%.0f%% efficiency): "
+                   "2 x %.2f = %.2fx with each server's core to itself\n",
+                   ab ? ", " : "", ab ? vname[v] : "", ne[v], e1.median, e2.median, 100.0 * e2.median / e1.median,
+                   e2.median / e1.median, 2.0 * e2.median / e1.median);
+        }
     }
-    if (r == SY_OK && ne) {
-        sy_bench_spread e1 = sy_bench_spread_of(eff[0], ne), e2 = sy_bench_spread_of(eff[1], ne);
-        printf("  per server CPU-second (median of %u): 1 server %.1f spp, 2 servers %.1f spp (%.0f%% efficiency): "
-               "2 x %.2f = %.2fx with each server's core to itself\n",
-               ne, e1.median, e2.median, 100.0 * e2.median / e1.median, e2.median / e1.median, 2.0 * e2.median / e1.median);
+    if (ab && r == SY_OK && nr) {
+        sy_bench_spread g1 = sy_bench_spread_of(gain[0], nr), g2 = sy_bench_spread_of(gain[1], nr);
+        printf("  pipelined over not pipelined, spp/s in the same round (median, min..max): 1 server %.3fx (%.3f..%.3f), "
+               "2 servers %.3fx (%.3f..%.3f)\n",
+               g1.median, g1.min, g1.max, g2.median, g2.min, g2.max);
     }
     return r;
 }
