@@ -11,6 +11,10 @@
  * raw peers speak plain TCP (raw_peer.h); a truncated HELLO is closed at the handshake deadline,
  * a header announcing more than the handshake budget is refused from the header alone, and
  * messages larger than a frame travel in frames both ways (64 KiB frames, an exact image).
+ * Cooperative pipelining (issue 39): the next frame's requests reach the servers before it is asked
+ * for, merges stay exact after answers used and dropped, a pipelined path tracer equals one without
+ * bit for bit (also after a camera move), and a fake server answering the request sent ahead twice,
+ * for a round not asked for, or late is dropped with the reason logged.
  *
  *   test_cluster_net SERVER_EXE WORK_DIR
  * Every server is started with --max-lifetime and stopped with SIGTERM (SIGKILL after 5 s), and
