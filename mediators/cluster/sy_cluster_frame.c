@@ -103,14 +103,13 @@ static void make_render(const frame_ctx *fc, const conn *k, uint32_t idx, const 
     q->tiles = (sy_cluster_rect *)&it->rect;
 }
 
-/* Cooperative pipelining: whether k's RENDER m is the one of its last frame, the frame before (frame,
- * sample_first and RESTART aside: a frame asked again); records m as k's last either way. */
+/* Cooperative pipelining: whether k's RENDER m is the one of its last frame, the frame before (frame
+ * and sample_first aside: a frame asked again); records m as k's last either way. */
 static bool steady_request(const sy_cluster_client *c, conn *k, const sy_cluster_msg *m)
 {
     sy_cluster_msg n = *m;
     n.u.render.frame = 0;
     n.u.render.sample_first = 0;
-    n.u.render.flags &= ~(uint32_t)SY_CLUSTER_RENDER_RESTART;
     sy_cluster_buf b = {0}, old = k->last_req;
     sy_error e = {0};
     bool ok = sy_cluster_encode(&n, 0, &b, &e) == SY_OK;
@@ -153,11 +152,12 @@ static sy_result run_item(frame_ctx *fc, conn *k, uint32_t idx, work_item *it, s
         r = sy_error_set(err, SY_ERR_PROTOCOL, "%s: tile rectangle differs from the request", k->url);
     /* pipelining: the next frame's request goes out before this answer is decoded and merged */
     if (!r && first_round && f->mode == SY_CLUSTER_COOPERATIVE && fc->single && fc->single[idx]) {
+        /* not after a SCENE or a RESTART (a caller that sends either every frame would only
+         * ever drop what was sent ahead) */
         bool steady = steady_request(c, k, &m);
-        if (steady && fc->pipeline && !k->scene_msg.size) {
+        if (steady && fc->pipeline && !k->scene_msg.size && !(m.u.render.flags & SY_CLUSTER_RENDER_RESTART)) {
             m.u.render.frame = c->frame + 1;
             m.u.render.sample_first = it->sample_first + fc->coop_span;
-            m.u.render.flags &= ~(uint32_t)SY_CLUSTER_RENDER_RESTART;
             k->ahead.size = 0;
             sy_result ra = sy_cluster_encode(&m, 0, &k->ahead, ahead_err);
             if (ra == SY_OK) ra = sy_clu_conn_send_ahead(c, k, c->frame + 1, m.u.render.job, ahead_err);

@@ -259,8 +259,8 @@ typedef struct conn {
     uint64_t ahead_frame;        /* the frame and job it names: its answer must name the same */
     uint32_t ahead_job;
     uint64_t ahead_used, ahead_dropped; /* answers to requests sent ahead: used / dropped, cumulative */
-    sy_cluster_buf last_req;     /* the last frame's RENDER with frame, sample_first and RESTART cleared
-                                    (size 0 = none): a frame that asks the same again is sent ahead */
+    sy_cluster_buf last_req;     /* the last frame's RENDER with frame and sample_first cleared (size 0 =
+                                    none): a frame that asks the same again is sent ahead */
     uint64_t last_req_frame;
 } conn;
 
