@@ -139,9 +139,10 @@ typedef struct sy_cluster_client_opts {
     const char *const *backends;
     const sy_cluster_rect *wall_tiles; /**< optional, see above */
     /** Cooperative frames are pipelined by default: once a server's RENDER of a frame is the same as
-     * the one of the frame before (no SCENE, same view, samples, parameters), the next frame's RENDER
-     * goes to it as soon as its answer is in, so it renders while the client merges; a next frame
-     * that asks otherwise receives and drops that answer first (at most one round per server).
+     * the one of the frame before (no SCENE or RESTART, same view, samples, parameters), the next
+     * frame's RENDER goes to it right after this frame's, so it has the next round queued and
+     * renders it while the client receives and merges; a next frame that asks otherwise receives
+     * and drops that answer first (at most one round per server; docs/CLUSTER.md).
      * true = never send ahead (each frame's requests only once it is asked for). */
     bool no_pipeline;
 } sy_cluster_client_opts;

@@ -86,6 +86,16 @@ sy_result sy_clu_conn_drain(sy_cluster_client *c, conn *k, sy_error *err)
     return r;
 }
 
+sy_result sy_clu_conn_request(sy_cluster_client *c, conn *k, const sy_cluster_msg *req, sy_error *err)
+{
+    sy_result r = sy_clu_conn_drain(c, k, err);
+    sy_cluster_buf buf = {0};
+    if (r == SY_OK) r = sy_cluster_encode(req, 0, &buf, err);
+    if (r == SY_OK) r = conn_send(c, k, &buf, conn_deadline(c, k), err);
+    sy_cluster_buf_free(&buf);
+    return r;
+}
+
 /* One request/reply exchange within timeout_ms (the handshake's deadline before the session is
  * open); an answer still owed to a request sent ahead is received and dropped first
  * (sy_clu_conn_drain). *reply borrows *raw (free it with free() after sy_cluster_msg_free). */
@@ -308,6 +318,14 @@ void sy_cluster_client_set_timeout(sy_cluster_client *c, uint32_t timeout_ms)
 void sy_cluster_client_destroy(sy_cluster_client *c)
 {
     if (!c) return;
+    /* a round sent ahead (cooperative pipelining) is finished and its answer dropped within the
+     * frames' deadline (the servers render them in parallel), so the servers see BYE, not a
+     * connection closed under a reply */
+    for (uint32_t i = 0; c->conns && i < c->n; ++i) {
+        sy_error e = {0};
+        if (c->conns[i].live && c->conns[i].ahead.size && sy_clu_conn_drain(c, &c->conns[i], &e) != SY_OK)
+            sy_clu_conn_close(&c->conns[i]);
+    }
     c->timeout_ms = 1000;
     for (uint32_t i = 0; c->conns && i < c->n; ++i) {
         conn *k = &c->conns[i];

@@ -122,9 +122,11 @@ static bool steady_request(const sy_cluster_client *c, conn *k, const sy_cluster
 }
 
 /* Runs one item on k: its RENDER (or the answer to the same request sent ahead), checks the answer,
- * and decodes it. Cooperative, when k asked the same in the frame before: the next frame's RENDER
- * goes to k as soon as this answer is in, before it is decoded and merged (a failure to send it is
- * left in *ahead_err: this answer still counts, the connection is dropped after). */
+ * and decodes it. Cooperative, when k asked the same in the frame before (no SCENE, no RESTART):
+ * the next frame's RENDER goes to k right after this frame's, before this answer is in, so k has
+ * it queued when it finishes this round and renders it while the client decodes and merges (a
+ * failure to send it is left in *ahead_err: this answer still counts, the connection is dropped
+ * after). */
 static sy_result run_item(frame_ctx *fc, conn *k, uint32_t idx, work_item *it, sy_error *ahead_err, sy_error *err)
 {
     sy_cluster_client *c = fc->c;
@@ -133,15 +135,28 @@ static sy_result run_item(frame_ctx *fc, conn *k, uint32_t idx, work_item *it, s
     make_render(fc, k, idx, it, &m);
     const __typeof__(m.u.render) *q = &m.u.render;
     bool first_round = (uint32_t)(it - fc->items) < fc->first_items;
+    /* not after a SCENE or a RESTART (a caller that sends either every frame would only ever drop
+     * what was sent ahead) */
+    bool ahead = first_round && f->mode == SY_CLUSTER_COOPERATIVE && fc->single && fc->single[idx] &&
+                 steady_request(c, k, &m) && fc->pipeline && !k->scene_msg.size && !(q->flags & SY_CLUSTER_RENDER_RESTART);
     uint8_t *raw = NULL;
-    sy_result r;
+    sy_result r = SY_OK;
     if (first_round && fc->ahead_hit && fc->ahead_hit[idx] && k->ahead.size) {
-        k->ahead.size = 0; /* this is its answer */
+        k->ahead.size = 0; /* sent during the last frame: its answer is this frame's */
         k->ahead_used++;
-        r = sy_clu_conn_recv(c, k, SY_CLUSTER_TILES, &rep, &raw, err);
     } else {
-        r = sy_clu_conn_call(c, k, &m, NULL, SY_CLUSTER_TILES, &rep, &raw, err); /* drops a stale answer first */
+        r = sy_clu_conn_request(c, k, &m, err); /* drops a stale answer first */
     }
+    if (r == SY_OK && ahead) {
+        sy_cluster_msg n = m;
+        n.u.render.frame = c->frame + 1;
+        n.u.render.sample_first = it->sample_first + fc->coop_span;
+        k->ahead.size = 0;
+        sy_result ra = sy_cluster_encode(&n, 0, &k->ahead, ahead_err);
+        if (ra == SY_OK) ra = sy_clu_conn_send_ahead(c, k, c->frame + 1, n.u.render.job, ahead_err);
+        if (ra != SY_OK) k->ahead.size = 0;
+    }
+    if (r == SY_OK) r = sy_clu_conn_recv(c, k, SY_CLUSTER_TILES, &rep, &raw, err);
     if (r) return r;
     const __typeof__(rep.u.tiles) *t = &rep.u.tiles;
     uint32_t expect_tiles = f->mode == SY_CLUSTER_MULTI_DISPLAY ? 0 : 1;
@@ -150,20 +165,6 @@ static sy_result run_item(frame_ctx *fc, conn *k, uint32_t idx, work_item *it, s
                          k->url, (unsigned long long)t->frame, t->job, t->tile_count);
     if (!r && expect_tiles && memcmp(&t->tiles[0].rect, &it->rect, sizeof it->rect) != 0)
         r = sy_error_set(err, SY_ERR_PROTOCOL, "%s: tile rectangle differs from the request", k->url);
-    /* pipelining: the next frame's request goes out before this answer is decoded and merged */
-    if (!r && first_round && f->mode == SY_CLUSTER_COOPERATIVE && fc->single && fc->single[idx]) {
-        /* not after a SCENE or a RESTART (a caller that sends either every frame would only
-         * ever drop what was sent ahead) */
-        bool steady = steady_request(c, k, &m);
-        if (steady && fc->pipeline && !k->scene_msg.size && !(m.u.render.flags & SY_CLUSTER_RENDER_RESTART)) {
-            m.u.render.frame = c->frame + 1;
-            m.u.render.sample_first = it->sample_first + fc->coop_span;
-            k->ahead.size = 0;
-            sy_result ra = sy_cluster_encode(&m, 0, &k->ahead, ahead_err);
-            if (ra == SY_OK) ra = sy_clu_conn_send_ahead(c, k, c->frame + 1, m.u.render.job, ahead_err);
-            if (ra != SY_OK) k->ahead.size = 0;
-        }
-    }
     if (!r && expect_tiles) {
         const sy_cluster_tile *tl = &t->tiles[0];
         if (f->mode == SY_CLUSTER_COOPERATIVE) {

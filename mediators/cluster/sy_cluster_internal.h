@@ -253,8 +253,9 @@ typedef struct conn {
     uint64_t bytes_sent, bytes_received;
     char error[SY_ERROR_MESSAGE_MAX];
     /* cooperative pipelining (sy_cluster_frame.c): at most one RENDER sent ahead, for the next
-     * frame, while this frame's answer is merged; its answer is used when the next frame asks the
-     * same, else received and dropped before anything else is sent (sy_clu_conn_drain) */
+     * frame, right after this frame's (the server has it queued when it finishes this one); its
+     * answer is owed after this frame's and used when the next frame asks the same, else received
+     * and dropped before anything else is sent (sy_clu_conn_drain) */
     sy_cluster_buf ahead;        /* its encoding (untagged); size 0 = none in flight */
     uint64_t ahead_frame;        /* the frame and job it names: its answer must name the same */
     uint32_t ahead_job;
@@ -289,6 +290,9 @@ void sy_clu_conn_drop(sy_cluster_client *c, conn *k, const char *what, const cha
  * open). *reply borrows *raw (free it with free() after sy_cluster_msg_free). */
 sy_result sy_clu_conn_call(sy_cluster_client *c, conn *k, sy_cluster_msg *req, const sy_cluster_buf *preencoded,
                            uint32_t expect, sy_cluster_msg *reply, uint8_t **raw, sy_error *err);
+/* Sends req without waiting for its answer (an answer owed to a request sent ahead is received and
+ * dropped first); the answer comes with sy_clu_conn_recv. */
+sy_result sy_clu_conn_request(sy_cluster_client *c, conn *k, const sy_cluster_msg *req, sy_error *err);
 /* The reply to a request already sent: within timeout_ms from now / by the deadline (sy_time_now
  * seconds); an ERROR or a type other than expect is an error. *reply borrows *raw as above. */
 sy_result sy_clu_conn_recv(sy_cluster_client *c, conn *k, uint32_t expect, sy_cluster_msg *reply, uint8_t **raw,
