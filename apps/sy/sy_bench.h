@@ -71,10 +71,12 @@ sy_result sy_bench_filters_scene(sy_scene *scene, const sy_viewport_desc *vd, co
 /* sy bench temporal (sy_bench_temporal.c, issue 36): the path tracer's temporal reuse on a camera
  * path of `frames` frames of 1 spp at width x height against references of ref_spp samples per view
  * (relMSE and flicker, plain and temporal, with their ratios), and the temporal stage's cost per
- * 640x360 frame. png_prefix (may be NULL): PREFIX_plain.png, PREFIX_temporal.png and
- * PREFIX_reference.png of the middle frame. */
+ * 640x360 frame (the median of cost_frames moving frames, 1..12, and its breakdown into the stage's
+ * parts). png_prefix (may be NULL): PREFIX_plain.png, PREFIX_temporal.png and PREFIX_reference.png of
+ * the middle frame. */
 sy_result sy_bench_temporal(sy_scene *scene, const sy_viewport_desc *vd, const char *label, uint32_t width,
-                            uint32_t height, uint32_t frames, uint32_t ref_spp, const char *png_prefix, sy_error *err);
+                            uint32_t height, uint32_t frames, uint32_t ref_spp, uint32_t cost_frames,
+                            const char *png_prefix, sy_error *err);
 
 /* sy bench instances (sy_bench_instances.c, built with the Embree back-ends): `instances` nodes
  * instancing one height field of about `tris` triangles, rendered with every picture back-end:

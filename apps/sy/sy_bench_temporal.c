@@ -110,12 +110,12 @@ static sy_result bench_win_make(const sy_viewport_desc *vd, const char *params, 
 static sy_result bench_win_frame(bench_win *b, const sy_mat4 *view, sy_scene *scene, sy_context_pool *pool,
                                  uint32_t samples, uint32_t seed, sy_layer *out, double *secs, sy_error *err);
 
-/* Sorts three series of 12 frames each (their medians at [6]). */
-static void sort12(double *a, double *b, double *c)
+/* Sorts three series of n frames each (their medians at [n / 2]). */
+static void sort3(uint32_t n, double *a, double *b, double *c)
 {
-    qsort(a, 12, sizeof a[0], sy_bench_cmp_double);
-    qsort(b, 12, sizeof b[0], sy_bench_cmp_double);
-    qsort(c, 12, sizeof c[0], sy_bench_cmp_double);
+    qsort(a, n, sizeof a[0], sy_bench_cmp_double);
+    qsort(b, n, sizeof b[0], sy_bench_cmp_double);
+    qsort(c, n, sizeof c[0], sy_bench_cmp_double);
 }
 
 /* One frame k of the object motion measurements: the scene (moved by the caller) committed and
@@ -159,10 +159,12 @@ static sy_result bench_win_frame(bench_win *b, const sy_mat4 *view, sy_scene *sc
 #endif
 
 sy_result sy_bench_temporal(sy_scene *scene, const sy_viewport_desc *vd, const char *label, uint32_t width,
-                            uint32_t height, uint32_t frames, uint32_t ref_spp, const char *png_prefix, sy_error *err)
+                            uint32_t height, uint32_t frames, uint32_t ref_spp, uint32_t cost_frames,
+                            const char *png_prefix, sy_error *err)
 {
 #ifndef SY_HAVE_EMBREE
-    (void)scene, (void)vd, (void)label, (void)width, (void)height, (void)frames, (void)ref_spp, (void)png_prefix;
+    (void)scene, (void)vd, (void)label, (void)width, (void)height, (void)frames, (void)ref_spp, (void)cost_frames;
+    (void)png_prefix;
     SY_BENCH_WITHOUT(err, "temporal", "SY_WITH_EMBREE");
 #else
     bench_win plain = {0}, temporal = {0}, ref = {0}, cost = {0};
@@ -275,35 +277,46 @@ sy_result sy_bench_temporal(sy_scene *scene, const sy_viewport_desc *vd, const c
                    stop, stop_plain, later, fl[2]);
     }
     sy_layer a = {0};
-    /* cost at 640x360: the temporal stage of 12 moving frames (median), and one 1-spp pass */
+    /* cost at 640x360: the temporal stage of cost_frames moving frames (median; its parts: the feature
+     * buffers' read, the filter's phases), and one 1-spp pass */
+    uint32_t cn = cost_frames < 1 ? 1 : cost_frames > 12 ? 12 : cost_frames, mid = cn / 2;
     sy_context *ctx = NULL;
     if (r == SY_OK) r = bench_win_make(vd, "temporal=1", 640, 360, &cost, err);
     sy_params tp = {0};
     if (r == SY_OK) r = sy_params_parse("temporal=1", &tp, err);
     if (r == SY_OK) r = sy_context_pool_get(pool, scene, "pathtracer", &tp, vd->root.id, &ctx, err);
-    double tt[12], tf[12], tc[12];
-    for (uint32_t k = 0; k < 13 && r == SY_OK; ++k) {
+    /* per frame: the stage, the frame without it, the filter's CPU time, the read, the filter's phases */
+    enum { C_STAGE, C_FRAME, C_CPU, C_READ, C_PHASE, C_COUNT = C_PHASE + 4 };
+    double cs[C_COUNT][12];
+    for (uint32_t k = 0; k <= cn && r == SY_OK; ++k) {
         sy_mat4 m;
         path_view(&home, k, &m);
         double s;
         r = bench_win_frame(&cost, &m, scene, pool, 1, 0, &a, &s, err);
         if (r == SY_OK && k > 0) {
             sy_mediator_rt_filter_info_get(sy_context_state(ctx), &fi);
-            tt[k - 1] = fi.temporal_seconds, tf[k - 1] = s - fi.temporal_seconds;
-            tc[k - 1] = fi.temporal_filter_cpu_seconds;
+            cs[C_STAGE][k - 1] = fi.temporal_seconds, cs[C_FRAME][k - 1] = s - fi.temporal_seconds;
+            cs[C_CPU][k - 1] = fi.temporal_filter_cpu_seconds, cs[C_READ][k - 1] = fi.temporal_read_seconds;
+            for (int q = 0; q < 4; ++q) cs[C_PHASE + q][k - 1] = fi.temporal_phase_seconds[q];
         }
     }
     if (r == SY_OK) {
-        sort12(tt, tf, tc);
-        printf("  cost at 640x360: temporal stage %.1f ms per frame (median of 12; AOV read + reprojection + "
+        for (int q = 0; q < C_COUNT; ++q) qsort(cs[q], cn, sizeof cs[q][0], sy_bench_cmp_double);
+        printf("  cost at 640x360: temporal stage %.1f ms per frame (median of %u; AOV read + reprojection + "
                "a-trous), the 1-spp frame without it %.1f ms: %.2fx; the filter's CPU time %.1f ms (all threads); "
                "reused history on %.0f %% of the hits\n",
-               tt[6] * 1e3, tf[6] * 1e3, tt[6] / tf[6], tc[6] * 1e3, 100.0 * fi.temporal_reused);
+               cs[C_STAGE][mid] * 1e3, cn, cs[C_FRAME][mid] * 1e3, cs[C_STAGE][mid] / cs[C_FRAME][mid],
+               cs[C_CPU][mid] * 1e3, 100.0 * fi.temporal_reused);
+        printf("  its parts (medians, wall ms): feature buffers read %.1f; filter: planes %.1f, reprojection and "
+               "blend %.1f, a-trous %.1f, output %.1f\n",
+               cs[C_READ][mid] * 1e3, cs[C_PHASE][mid] * 1e3, cs[C_PHASE + 1][mid] * 1e3, cs[C_PHASE + 2][mid] * 1e3,
+               cs[C_PHASE + 3][mid] * 1e3);
     }
     /* object motion at 640x360: the camera still at the path's start, every node under the viewport's
-     * root with a mesh (and no light or camera: a moved light is not a move) sliding sideways by 0.2 % of the orbit distance per frame (every instance moves), 12
-     * frames: the object motion pass (coverage rays + per-pixel motion) against the rest of the
-     * temporal stage (AOV read, reprojection, a-trous) */
+     * root with a mesh (and no light or camera: a moved light is not a move) sliding sideways by 0.2 %
+     * of the orbit distance per frame (every instance moves), cost_frames frames: the object motion
+     * pass (coverage rays + per-pixel motion) against the rest of the temporal stage (AOV read,
+     * reprojection, a-trous) */
     uint32_t nkids = 0;
     uint32_t *kids = NULL;
     if (r == SY_OK) r = moving_nodes(scene, vd->root, &kids, &nkids, err);
@@ -312,7 +325,7 @@ sy_result sy_bench_temporal(sy_scene *scene, const sy_viewport_desc *vd, const c
     for (uint32_t i = 0; saved && i < nkids; ++i) saved[i] = sy_node_get(scene, (sy_node){kids[i]})->transform.matrix;
     double om[12] = {0}, os[12] = {0}, ot[12] = {0};
     uint64_t moving = 0;
-    for (uint32_t k = 0; k < 13 && r == SY_OK && saved; ++k) {
+    for (uint32_t k = 0; k <= cn && r == SY_OK && saved; ++k) {
         for (uint32_t i = 0; i < nkids && r == SY_OK; ++i) {
             sy_mat4 m = saved[i];
             m.m[12] += 0.002f * home.orbit.dist * (float)k;
@@ -325,23 +338,23 @@ sy_result sy_bench_temporal(sy_scene *scene, const sy_viewport_desc *vd, const c
         for (uint32_t i = 0; i < nkids; ++i) (void)sy_node_set_matrix(scene, (sy_node){kids[i]}, &saved[i], NULL);
         (void)sy_scene_commit(scene, NULL, NULL);
         if (r == SY_OK) {
-            sort12(om, os, ot);
+            sort3(cn, om, os, ot);
             printf("  object motion at 640x360 (still camera, every instance sliding): motion pass %.2f ms per frame "
-                   "(median of 12; coverage rays + per-pixel motion, of it the per-pixel motion %.2f ms), the rest of "
+                   "(median of %u; coverage rays + per-pixel motion, of it the per-pixel motion %.2f ms), the rest of "
                    "the temporal stage %.1f ms: %.2fx; %llu moving pixels\n",
-                   om[6] * 1e3, ot[6] * 1e3, os[6] * 1e3, om[6] / os[6], (unsigned long long)moving);
+                   om[mid] * 1e3, cn, ot[mid] * 1e3, os[mid] * 1e3, om[mid] / os[mid], (unsigned long long)moving);
         }
         free(saved);
     }
     free(kids);
     /* deforming meshes at 640x360: a scene with an animation plays it (every clip, 1/24 s per frame)
-     * under the still camera, 12 frames: the object motion pass with per-vertex motion (coverage
+     * under the still camera, cost_frames frames: the object motion pass with per-vertex motion (coverage
      * rays with triangles and barycentrics + the hit at the earlier pose) against the rest of the
      * stage and against the rigid pass above (same run, same view) */
     double dm[12], ds[12], dt[12];
     uint64_t dpx = 0, dmov = 0;
     bool animated = false;
-    for (uint32_t k = 0; k < 13 && r == SY_OK; ++k) {
+    for (uint32_t k = 0; k <= cn && r == SY_OK; ++k) {
         sy_anim_stats as = {0};
         r = sy_scene_set_time_ex(scene, (sy_animation){0}, (double)k / 24.0, &as, err);
         if (r != SY_OK || (k == 0 && as.channels == 0 && as.weights == 0)) break;
@@ -350,12 +363,12 @@ sy_result sy_bench_temporal(sy_scene *scene, const sy_viewport_desc *vd, const c
         dpx = fi.temporal_deformed_pixels, dmov = fi.temporal_moving_pixels;
     }
     if (r == SY_OK && animated) {
-        sort12(dm, ds, dt);
+        sort3(cn, dm, ds, dt);
         printf("  animation at 640x360 (still camera, every clip at 24 fps): motion pass %.2f ms per frame (median of "
-               "12; per-vertex motion on %llu deformed pixels of %llu moving; of it the per-pixel motion %.2f ms), the "
+               "%u; per-vertex motion on %llu deformed pixels of %llu moving; of it the per-pixel motion %.2f ms), the "
                "rest of the temporal stage %.1f ms: %.2fx; the rigid pass above %.2f ms: %.2fx of it\n",
-               dm[6] * 1e3, (unsigned long long)dpx, (unsigned long long)dmov, dt[6] * 1e3, ds[6] * 1e3, dm[6] / ds[6],
-               om[6] * 1e3, om[6] > 0 ? dm[6] / om[6] : 0.0);
+               dm[mid] * 1e3, cn, (unsigned long long)dpx, (unsigned long long)dmov, dt[mid] * 1e3, ds[mid] * 1e3,
+               dm[mid] / ds[mid], om[mid] * 1e3, om[mid] > 0 ? dm[mid] / om[mid] : 0.0);
     }
     for (int q = 0; q <= SERIES; ++q) free(prev[q]), sy_layer_destroy(&img[q]);
     sy_layer_destroy(&a);

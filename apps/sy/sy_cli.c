@@ -263,7 +263,7 @@ static const char usage_text[] =
             "  sy bench lights [--nodes QUADS] [--tris POINT_LIGHTS] [-w W] [-h H] [--repeats SECONDS]\n"
             "            (many lights: the light tree vs the alias table at equal time, 10^4 + 10^3 by default)\n"
             "  sy bench filters [SCENE --reference REF.exr] [SHEET.png] [-w W] [-h H] [--repeats R]\n"
-            "  sy bench temporal [SCENE...] [-w W] [-h H] [--frames N] [--spp REF] [--png PREFIX]   (temporal reuse, moving camera)\n"
+            "  sy bench temporal [SCENE...] [-w W] [-h H] [--frames N] [--spp REF] [--cost-frames N] [--png PREFIX]   (temporal reuse, moving camera)\n"
             "  sy bench raster [SCENE] [-w W] [-h H] [--repeats R] [--params gl=egl,msaa=4]\n"
             "  sy bench viewports [-w W] [-h H] [--repeats R]\n"
             "  sy bench load [GLTF_SAMPLE_DIR] [--tris T] [--repeats R]\n"

@@ -913,8 +913,12 @@ sy_filter_status sy_filter_temporal_run(sy_filter_temporal *t, const sy_filter_f
     tctx c = {.t = t, .in = in, .prev = t->have_prev ? &t->h[t->prev] : NULL, .next = nx, .n = n, .W = t->work,
               .xmax = EXP_MAX, .out = out};
     uint32_t th = t->p.threads, rows = in->height;
+    double ph[5];
+    ph[0] = sy_filter_clock(false);
     sy_filter_parallel_rows(th, rows, demod_rows, &c);
+    ph[1] = sy_filter_clock(false);
     sy_filter_parallel_rows(th, rows, integrate_rows, &c);
+    ph[2] = sy_filter_clock(false);
     /* the a-trous passes: the indirect part (or the colour), then the direct part when split */
     bool split = in->direct && in->indirect;
     for (int k = 0; k < 2; ++k) {
@@ -941,6 +945,7 @@ sy_filter_status sy_filter_temporal_run(sy_filter_temporal *t, const sy_filter_f
 #undef Q
     }
     c.var0 = plane(&c, part_index(0, P_VAR));
+    ph[3] = sy_filter_clock(false);
     sy_filter_parallel_rows(th, rows, remod_rows, &c);
     nx->w = in->width, nx->h = in->height;
     memcpy(nx->world_to_pixel, world_to_pixel, sizeof nx->world_to_pixel);
@@ -962,6 +967,8 @@ sy_filter_status sy_filter_temporal_run(sy_filter_temporal *t, const sy_filter_f
         st.mean_history = hits ? hsum / (double)hits : 0.0;
         st.cpu_seconds = sy_filter_clock(true) - c0;
         st.seconds = sy_filter_clock(false) - t0;
+        ph[4] = t0 + st.seconds;
+        for (int k = 0; k < 4; ++k) st.phase_seconds[k] = ph[k + 1] - ph[k];
         *stats = st;
     }
     return SY_FILTER_OK;

@@ -88,7 +88,17 @@ typedef struct sy_filter_temporal_stats {
     double mean_history;     /**< mean history length (frames) over the hits after this frame */
     double seconds;          /**< wall time of the call */
     double cpu_seconds;      /**< CPU time of the process during the call (all its threads) */
+    /** wall time of the call's phases (SY_FILTER_TEMPORAL_PHASE_*; they add up to about seconds) */
+    double phase_seconds[4];
 } sy_filter_temporal_stats;
+
+/** The phases of sy_filter_temporal_stats.phase_seconds. */
+enum {
+    SY_FILTER_TEMPORAL_PHASE_PLANES = 0,  /**< the frame's planes: validity, demodulation */
+    SY_FILTER_TEMPORAL_PHASE_REPROJECT,   /**< 3x3 statistics, reprojection, clamping, moving averages */
+    SY_FILTER_TEMPORAL_PHASE_ATROUS,      /**< variance blurs and a-trous passes */
+    SY_FILTER_TEMPORAL_PHASE_OUTPUT       /**< remodulation, the output and the statistics */
+};
 
 /** A temporal reuse state (opaque). */
 typedef struct sy_filter_temporal sy_filter_temporal;

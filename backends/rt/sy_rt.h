@@ -737,6 +737,12 @@ const char *sy_rt_aov_name(sy_rt_aov aov);  /**< "color", "variance", ... ; NULL
 /** Copies one feature buffer into out (width * height * channels floats, interleaved). dev (may be
  * NULL) only receives the error report. */
 sy_rt_result sy_rt_accum_read(sy_rt_device *dev, const sy_rt_accum *accum, sy_rt_aov aov, float *out);
+/** Several feature buffers' rows [y0, y1) in one pass over the accumulation (the values
+ * sy_rt_accum_read gives): out[k] (NULL = not read) is AOV k's whole buffer (width * height *
+ * channels floats), of which only those rows are written. Calls for disjoint rows may run at the
+ * same time (a caller's threads split the rows); dev (may be NULL) only receives the error report. */
+sy_rt_result sy_rt_accum_read_rows(sy_rt_device *dev, const sy_rt_accum *accum, uint32_t y0, uint32_t y1,
+                                   float *const out[SY_RT_AOV_COUNT]);
 
 /* >>path records (PATHTRACER): the stored-sample hook of radiance filtering
  *

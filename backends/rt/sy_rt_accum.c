@@ -138,3 +138,28 @@ sy_rt_result sy_rt_accum_read(sy_rt_device *dev, const sy_rt_accum *a, sy_rt_aov
     }
     return SY_RT_OK;
 }
+
+sy_rt_result sy_rt_accum_read_rows(sy_rt_device *dev, const sy_rt_accum *a, uint32_t y0, uint32_t y1,
+                                   float *const out[SY_RT_AOV_COUNT])
+{
+    if (!a || !out) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "accum read rows: NULL argument");
+    if (y0 > y1 || y1 > a->height)
+        return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "accum read rows: rows %u..%u outside 0..%u", y0, y1, a->height);
+    float *col = out[SY_RT_AOV_COLOR], *var = out[SY_RT_AOV_VARIANCE], *alb = out[SY_RT_AOV_ALBEDO];
+    float *nrm = out[SY_RT_AOV_NORMAL], *dep = out[SY_RT_AOV_DEPTH], *dir = out[SY_RT_AOV_DIRECT];
+    float *ind = out[SY_RT_AOV_INDIRECT];
+    float nn = (float)a->samples;
+    bool many = a->samples > 1;
+    for (size_t i = (size_t)y0 * a->width, i1 = (size_t)y1 * a->width; i < i1; ++i) {
+        const float *r = a->data + i * SY_RT_ACC_STRIDE;
+        if (col) memcpy(col + 4 * i, r + SY_RT_ACC_COLOR, 4 * sizeof(float));
+        if (var)
+            for (int k = 0; k < 3; ++k) var[3 * i + k] = many ? r[SY_RT_ACC_M2 + k] / ((nn - 1.0f) * nn) : 0.0f;
+        if (alb) memcpy(alb + 3 * i, r + SY_RT_ACC_ALBEDO, 3 * sizeof(float));
+        if (nrm) memcpy(nrm + 3 * i, r + SY_RT_ACC_NORMAL, 3 * sizeof(float));
+        if (dep) dep[i] = r[SY_RT_ACC_HITS] > 0.0f ? r[SY_RT_ACC_DEPTH] : INFINITY;
+        if (dir) memcpy(dir + 3 * i, r + SY_RT_ACC_DIRECT, 3 * sizeof(float));
+        if (ind) memcpy(ind + 3 * i, r + SY_RT_ACC_INDIRECT, 3 * sizeof(float));
+    }
+    return SY_RT_OK;
+}

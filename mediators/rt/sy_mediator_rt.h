@@ -152,6 +152,9 @@ typedef struct sy_mediator_rt_filter_info {
     uint64_t temporal_frames;   /**< frames that showed the temporal estimate so far */
     double temporal_seconds;    /**< the last such frame's temporal stage (AOV read + filter), wall time */
     double temporal_filter_cpu_seconds; /**< of it: the filter's CPU time (all threads; sy_filter_temporal_stats) */
+    double temporal_read_seconds;   /**< of it: reading the feature buffers and their world positions (wall) */
+    double temporal_filter_seconds; /**< of it: the filter call (wall; sy_filter_temporal_run) */
+    double temporal_phase_seconds[4]; /**< the filter call's phases (sy_filter_temporal_stats.phase_seconds) */
     double temporal_reused;     /**< the last such frame: share of hit pixels with a reprojected history */
     bool temporal_rest_last;    /**< the last render rested after moving frames: the accumulation blended
                                      with the last estimate (sy_filter_temporal_rest) */

@@ -4,6 +4,7 @@
 #include "sy_mediator_rt_internal.h"
 
 #include <math.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -254,27 +255,51 @@ void sy_mediator_rt_filter_info_get(void *state, sy_mediator_rt_filter_info *out
     out->temporal = st->filter.temporal;
 }
 
-/* World positions of the first hits of the rectangle's pixels from the camera-axis depth (the
- * a-trous guide and the headlight of the pixel filter's range buffer); misses go 1e18 away. */
-static void filter_positions(const sy_render_request *req, const float *depth, float *pos)
+/* World positions of the first hits of rows [y0, y1) of the rectangle's pixels from the camera-axis
+ * depth (the a-trous guide and the headlight of the pixel filter's range buffer); misses go 1e18
+ * away. */
+static void filter_positions(const sy_render_request *req, const float *depth, float *pos, uint32_t y0, uint32_t y1)
 {
     const sy_camera_view *v = &req->camera;
     const float *m = v->camera_to_world.m;
     bool ortho = v->projection == SY_PROJECTION_ORTHOGRAPHIC;
-    for (uint32_t y = 0; y < req->rect_h; ++y)
+    for (uint32_t y = y0; y < y1; ++y) {
+        float w = v->window[3] - (v->window[3] - v->window[2]) * ((float)(req->rect_y + y) + 0.5f) / (float)req->full_height;
         for (uint32_t x = 0; x < req->rect_w; ++x) {
             size_t i = (size_t)y * req->rect_w + x;
             float u = v->window[0] + (v->window[1] - v->window[0]) * ((float)(req->rect_x + x) + 0.5f) / (float)req->full_width;
-            float w = v->window[3] - (v->window[3] - v->window[2]) * ((float)(req->rect_y + y) + 0.5f) / (float)req->full_height;
             float d = depth[i];
             if (!isfinite(d)) d = 1e18f;
             float c[3] = {ortho ? u : u * d, ortho ? w : w * d, -d};
             for (int k = 0; k < 3; ++k) pos[3 * i + k] = m[k] * c[0] + m[4 + k] * c[1] + m[8 + k] * c[2] + m[12 + k];
         }
+    }
 }
 
-/* Reads the slot's feature buffers (rect_w x rect_h) into st->fbuf (the filters' inputs). */
-sy_result sy_rti_filter_read_aovs(rt_state *st, const accum_slot *a, const sy_render_request *req, sy_error *err)
+/* the rows of sy_rti_filter_read_aovs: the feature buffers in one pass, then the positions */
+typedef struct read_rows_ctx {
+    const sy_rt_accum *acc;
+    const sy_render_request *req;
+    float *out[SY_RT_AOV_COUNT];
+    float *pos; /* NULL: none */
+    _Atomic int failed;
+} read_rows_ctx;
+
+static void read_rows(void *vc, uint32_t y0, uint32_t y1)
+{
+    read_rows_ctx *c = vc;
+    if (sy_rt_accum_read_rows(NULL, c->acc, y0, y1, c->out) != SY_RT_OK) {
+        atomic_store(&c->failed, 1);
+        return;
+    }
+    if (c->pos) filter_positions(c->req, c->out[SY_RT_AOV_DEPTH], c->pos, y0, y1);
+}
+
+/* Reads the slot's feature buffers (rect_w x rect_h) into st->fbuf (the filters' inputs): the variance
+ * only with `variance`, the world positions (fbuf[SY_RT_AOV_COUNT]) with `positions`. One pass over
+ * the accumulation, rows split over the filters' threads. */
+sy_result sy_rti_filter_read_aovs(rt_state *st, const accum_slot *a, const sy_render_request *req, bool variance,
+                                  bool positions, sy_error *err)
 {
     size_t n = (size_t)req->rect_w * req->rect_h;
     if (n > st->fbuf_px) {
@@ -290,22 +315,28 @@ sy_result sy_rti_filter_read_aovs(rt_state *st, const accum_slot *a, const sy_re
                                     req->rect_h);
             }
     }
-    for (int k = 0; k < SY_RT_AOV_COUNT; ++k) {
-        sy_rt_result rr = sy_rt_accum_read(st->dev, a->acc, (sy_rt_aov)k, st->fbuf[k]);
-        if (rr != SY_RT_OK) return sy_rti_fail(st, err, rr, "pathtracer filter: feature buffers");
-    }
+    uint32_t aw, ah;
+    sy_rt_accum_size(a->acc, &aw, &ah);
+    if (aw != req->rect_w || ah != req->rect_h) /* the slot is the request's rectangle (sy_rti_pt_slot) */
+        return sy_error_set(err, SY_ERR_BACKEND, "pathtracer filter: feature buffers of %ux%u for a %ux%u rectangle",
+                            aw, ah, req->rect_w, req->rect_h);
+    read_rows_ctx c = {.acc = a->acc, .req = req, .pos = positions ? st->fbuf[SY_RT_AOV_COUNT] : NULL};
+    for (int k = 0; k < SY_RT_AOV_COUNT; ++k) c.out[k] = k == SY_RT_AOV_VARIANCE && !variance ? NULL : st->fbuf[k];
+    atomic_init(&c.failed, 0);
+    sy_filter_parallel_rows(st->filter.atrous.threads, ah, read_rows, &c);
+    if (atomic_load(&c.failed)) /* not reached: the rows lie in the accumulation */
+        return sy_error_set(err, SY_ERR_BACKEND, "pathtracer filter: feature buffers: rows outside the accumulation");
     return SY_OK;
 }
 
 /* Filters the layer the path tracer just wrote (rectangle of the slot st->last_slot). */
 /* The slot's AOVs read into the scratch planes, world positions made from depth, and the filter
  * frame over them (every filter, the temporal stage included, reads what it needs of it). */
-static sy_result read_frame(rt_state *st, accum_slot *a, const sy_render_request *req, uint32_t samples,
+static sy_result read_frame(rt_state *st, accum_slot *a, const sy_render_request *req, uint32_t samples, bool variance,
                             sy_filter_frame *f, sy_error *err)
 {
-    sy_result rd = sy_rti_filter_read_aovs(st, a, req, err);
+    sy_result rd = sy_rti_filter_read_aovs(st, a, req, variance, true, err);
     if (rd != SY_OK) return rd;
-    filter_positions(req, st->fbuf[SY_RT_AOV_DEPTH], st->fbuf[SY_RT_AOV_COUNT]);
     const float *m = req->camera.camera_to_world.m;
     *f = (sy_filter_frame){
         .width = req->rect_w,
@@ -313,7 +344,7 @@ static sy_result read_frame(rt_state *st, accum_slot *a, const sy_render_request
         .color_channels = 4,
         .variance_channels = 3,
         .color = st->fbuf[SY_RT_AOV_COLOR],
-        .variance = st->fbuf[SY_RT_AOV_VARIANCE],
+        .variance = variance ? st->fbuf[SY_RT_AOV_VARIANCE] : NULL,
         .albedo = st->fbuf[SY_RT_AOV_ALBEDO],
         .normal = st->fbuf[SY_RT_AOV_NORMAL],
         .depth = st->fbuf[SY_RT_AOV_DEPTH],
@@ -332,7 +363,7 @@ sy_result sy_rti_filter_layer(rt_state *st, const sy_render_request *req, sy_lay
     accum_slot *a = &st->slots[st->last_slot];
     uint32_t samples = sy_rt_accum_samples(a->acc);
     sy_filter_frame f;
-    sy_result rd = read_frame(st, a, req, samples, &f, err);
+    sy_result rd = read_frame(st, a, req, samples, true, &f, err);
     if (rd != SY_OK) return rd;
     sy_filter_stats fs = {0};
     sy_filter_report fe = {0};
@@ -581,6 +612,11 @@ sy_result sy_rti_temporal_layer(rt_state *st, const sy_render_request *req, uint
     return r;
 }
 
+static double seconds_between(const struct timespec *a, const struct timespec *b)
+{
+    return (double)(b->tv_sec - a->tv_sec) + 1e-9 * (double)(b->tv_nsec - a->tv_nsec);
+}
+
 static sy_result temporal_frame(rt_state *st, const sy_render_request *req, uint32_t samples, bool moved,
                                 sy_layer *layer, bool *done, sy_error *err)
 {
@@ -608,16 +644,18 @@ static sy_result temporal_frame(rt_state *st, const sy_render_request *req, uint
         if (sy_filter_temporal_create(&p, &st->temporal, &fe)) return filter_fail(err, &fe);
     }
     sy_filter_frame f;
-    sy_result rd = read_frame(st, a, req, samples, &f, err);
+    struct timespec tr0, tm0, tm1;
+    clock_gettime(CLOCK_MONOTONIC, &tr0);
+    sy_result rd = read_frame(st, a, req, samples, false, &f, err); /* the stage reads no variance */
     if (rd != SY_OK) return rd;
-    struct timespec tm0, tm1;
     clock_gettime(CLOCK_MONOTONIC, &tm0);
+    st->finfo.temporal_read_seconds = seconds_between(&tr0, &tm0);
     bool any = false;
     uint64_t moving = 0, deformed = 0;
     if ((rd = object_motion(st, req, f.position, &any, &moving, &deformed, err)) != SY_OK) return rd;
     if (any) f.motion = st->motion_buf;
     clock_gettime(CLOCK_MONOTONIC, &tm1);
-    st->finfo.temporal_motion_seconds = any ? (double)(tm1.tv_sec - tm0.tv_sec) + 1e-9 * (double)(tm1.tv_nsec - tm0.tv_nsec) : 0.0;
+    st->finfo.temporal_motion_seconds = any ? seconds_between(&tm0, &tm1) : 0.0;
     st->finfo.temporal_moving_pixels = moving;
     st->finfo.temporal_deformed_pixels = deformed;
     sy_filter_temporal_stats ts = {0};
@@ -626,8 +664,10 @@ static sy_result temporal_frame(rt_state *st, const sy_render_request *req, uint
     uint64_t hits = ts.reprojected + ts.disoccluded;
     st->finfo.temporal_last = true;
     st->finfo.temporal_frames++;
-    st->finfo.temporal_seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+    st->finfo.temporal_seconds = seconds_between(&t0, &t1);
     st->finfo.temporal_filter_cpu_seconds = ts.cpu_seconds;
+    st->finfo.temporal_filter_seconds = ts.seconds;
+    memcpy(st->finfo.temporal_phase_seconds, ts.phase_seconds, sizeof ts.phase_seconds);
     st->finfo.temporal_reused = hits ? (double)ts.reprojected / (double)hits : 0.0;
     *done = true;
     return SY_OK;

@@ -226,7 +226,10 @@ bool sy_rti_same_view(const sy_camera_view *a, const sy_camera_view *b);
 /* --- sy_mediator_rt_filter.c --- */
 void sy_rti_filter_cfg_default(pt_filter_cfg *c, uint32_t threads);
 sy_result sy_rti_filter_cfg_apply(pt_filter_cfg *base, const char *name, const sy_params *p_in, bool all, sy_error *err);
-sy_result sy_rti_filter_read_aovs(rt_state *st, const accum_slot *a, const sy_render_request *req, sy_error *err);
+/* The slot's feature buffers into st->fbuf (the variance with `variance`; the world positions, the
+ * last plane, with `positions`): one pass, rows split over the filters' threads. */
+sy_result sy_rti_filter_read_aovs(rt_state *st, const accum_slot *a, const sy_render_request *req, bool variance,
+                                  bool positions, sy_error *err);
 sy_result sy_rti_filter_layer(rt_state *st, const sy_render_request *req, sy_layer *layer, sy_error *err);
 /* Temporal reuse after a path-traced render of `samples` samples into the slot st->last_slot: when
  * st->filter.temporal is on, the accumulation holds only this render's samples and the camera moved

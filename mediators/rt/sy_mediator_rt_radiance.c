@@ -21,7 +21,7 @@ sy_result sy_rti_radiance_render(rt_state *st, const sy_render_request *req, con
                                       .orthographic = ortho};
     uint32_t prior = sy_rt_accum_samples(a->acc);
     if (sy_radiance_hook_frame_index(a->radiance) == 0 && prior > 0) { /* resume on the accumulation */
-        if ((r = sy_rti_filter_read_aovs(st, a, req, err)) != SY_OK) return r;
+        if ((r = sy_rti_filter_read_aovs(st, a, req, true, false, err)) != SY_OK) return r;
         fd.prior_samples = prior;
         fd.prior_color = st->fbuf[SY_RT_AOV_COLOR];
         fd.prior_color_channels = 4;
