@@ -10,8 +10,20 @@
  * vectorises it (-ftree-vectorize, CMakeLists.txt; check with -fopt-info-vec). A neighbour of
  * another class (hit with a normal, hit without one, none) gets weight 0 through a select. Per
  * pixel, the taps are summed in the order the scalar version summed them (centre, then dy, dx
- * row-major), so results do not depend on the vector width or the thread count. Only the
- * reprojection (4 gathered taps of the previous history) stays a scalar per-pixel loop. */
+ * row-major), so results do not depend on the vector width or the thread count. The reprojection
+ * (4 gathered taps of the previous history per pixel), which GCC does not vectorise, has an AVX2
+ * version written with gathers (reproject_row_avx2, the same operations per lane) beside the scalar
+ * loop. Passes that stream the same planes run together: the direct and indirect parts share each
+ * variance blur and a-trous pass (atrous_row8_2: the class, depth and normal terms once; the 3x3
+ * statistics of both parts in one loop took more instructions, 31 M against 27 M a frame: the
+ * loop's 30 streams spill registers), the demodulation writes the next history's positions and
+ * normals (also the a-trous passes' normal planes), the first a-trous pass of the indirect part
+ * writes into the next history and the blend of the direct part too (no copies).
+ *
+ * Cost per 640x360 frame (callgrind, `sy bench temporal ... --cost-frames 2`, the stage with its
+ * feature buffers' read): about 500 M instructions before these (the reprojection 142 M scalar,
+ * the a-trous 132 M, the read 46 M single-threaded), about 300 M after (the a-trous 121 M, the
+ * reprojection 30 M); see docs/FILTERS.md for wall times. */
 #include "sy_filter_temporal.h"
 
 #include <math.h>
@@ -34,6 +46,14 @@
 #define SY_TEMPORAL_CLONES __attribute__((target_clones("avx2", "default")))
 #else
 #define SY_TEMPORAL_CLONES
+#endif
+/* the reprojection's gathers, written with AVX2 intrinsics (GCC does not vectorise them), picked at
+ * run time */
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define SY_TEMPORAL_AVX2 1
+#include <immintrin.h>
+#else
+#define SY_TEMPORAL_AVX2 0
 #endif
 
 /* branch-free min / max without the library call GCC emits for fmaxf's NaN rules */
@@ -85,8 +105,7 @@ enum {
     W_HIT,          /* 1 for a hit (class > 0), else 0 */
     W_SN,           /* the centre's normal edge stop: sigma_normal for class 2, else 0 */
     W_Z,            /* depth (0 where no hit) */
-    W_N,            /* 3: normal (0 where no hit) */
-    W_MOD = W_N + 3, /* 3: albedo modulation */
+    W_MOD,          /* 3: albedo modulation (the normals, 0 where no hit, are the next history's nrm) */
     W_CUR = W_MOD + 3, /* 6: the new samples demodulated, indirect part (or colour) then direct part */
     W_LUM = W_CUR + 6, /* 2: their luminance, per part */
     W_ZG = W_LUM + 2,  /* depth gradient */
@@ -98,7 +117,8 @@ enum {
     W_PART,         /* per part (2): acc 3, var, lacc = 5 */
     W_SCR = W_PART + 2 * 5, /* per part (2): the a-trous ping-pong planes a 3, va, la, b 3, vb, lb = 10 */
     W_PP = W_SCR + 2 * 10,  /* 3: the hits' world positions at the previous frame (position + motion) */
-    W_COUNT = W_PP + 3
+    W_IL2 = W_PP + 3,       /* the direct part's luminance stop (W_IL's, when both parts are filtered together) */
+    W_COUNT
 };
 /* a part's planes (part_index)  */
 enum { P_ACC = 0, P_VAR = 3, P_LACC = 4, P_A = 5, P_VA = 8, P_LA = 9, P_B = 10, P_VB = 13, P_LB = 14 };
@@ -258,11 +278,13 @@ typedef struct tctx {
     hist *next;
     size_t n;         /* pixels */
     float *W;         /* the working planes */
-    /* a-trous pass: src, dst 3 planes each */
-    const float *src, *vsrc, *lsrc;
-    float *dst, *vdst, *ldst;
+    /* a-trous pass: src, dst 3 planes each; with two, the direct part's src2, dst2 in the same pass */
+    const float *src, *vsrc, *lsrc, *src2, *vsrc2, *lsrc2;
+    float *dst, *vdst, *ldst, *dst2, *vdst2, *ldst2;
+    bool two;
     int step;
     float xmax; /* EXP_MAX, through memory (see expneg) */
+    bool avx2;  /* the CPU has AVX2 (reproject_row_avx2) */
     const float *outp[2]; /* the parts' final planes (remodulation) */
     const float *vout[2]; /* their final variance */
     const float *var0;    /* the indirect part's (or colour's) variance before the a-trous passes */
@@ -330,7 +352,7 @@ static inline SY_TEMPORAL_INLINE float nonfinite0(float x)
                      float *restrict n1, float *restrict n2, float *restrict m0, float *restrict m1,                   \
                      float *restrict m2, float *restrict c0, float *restrict c1, float *restrict c2,                   \
                      float *restrict d0, float *restrict d1, float *restrict d2, float *restrict l0,                   \
-                     float *restrict l1)                                                                               \
+                     float *restrict l1, float *restrict q0, float *restrict q1, float *restrict q2)                   \
     {                                                                                                                 \
         const int cc = CC;                                                                                            \
         const bool split = SPLIT;                                                                                     \
@@ -349,9 +371,12 @@ static inline SY_TEMPORAL_INLINE float nonfinite0(float x)
         okp[i] = okf, cls[i] = hitf + hnf, hitp[i] = hitf, snp[i] = hnf * sn;                                         \
         zp[i] = hitf > 0.0f ? d : 0.0f;                                                                               \
         n0[i] = hitf > 0.0f ? nn[0] : 0.0f, n1[i] = hitf > 0.0f ? nn[1] : 0.0f, n2[i] = hitf > 0.0f ? nn[2] : 0.0f;   \
-        /* dark albedo keeps the radiance (as a-trous) */                                                             \
-        float ma = hitf > 0.0f && a[0] > 0.01f ? a[0] : 1.0f, mb = hitf > 0.0f && a[1] > 0.01f ? a[1] : 1.0f,         \
-              mc = hitf > 0.0f && a[2] > 0.01f ? a[2] : 1.0f;                                                         \
+        q0[i] = hitf > 0.0f ? p[0] : 0.0f, q1[i] = hitf > 0.0f ? p[1] : 0.0f, q2[i] = hitf > 0.0f ? p[2] : 0.0f;      \
+        /* dark albedo keeps the radiance (as a-trous); hitf x (0/1), not &&: GCC vectorises no select on a   \
+         * mix of two comparisons */                                                                                  \
+        float ma = hitf * (float)(a[0] > 0.01f) > 0.0f ? a[0] : 1.0f,                                                 \
+              mb = hitf * (float)(a[1] > 0.01f) > 0.0f ? a[1] : 1.0f,                                                 \
+              mc = hitf * (float)(a[2] > 0.01f) > 0.0f ? a[2] : 1.0f;                                                 \
         m0[i] = ma, m1[i] = mb, m2[i] = mc;                                                                           \
         float x0 = split ? ind[3 * i] : cl[0], x1 = split ? ind[3 * i + 1] : cl[1], x2 = split ? ind[3 * i + 2] : cl[2];\
         float r0 = okf > 0.0f ? x0 / ma : 0.0f, r1 = okf > 0.0f ? x1 / mb : 0.0f, r2 = okf > 0.0f ? x2 / mc : 0.0f;   \
@@ -380,12 +405,13 @@ static void demod_rows(void *vc, uint32_t y0, uint32_t y1)
     bool split = in->direct && in->indirect;
     float *W = c->W;
     size_t n = c->n;
+    hist *NX = c->next; /* the next history's normals and positions (0 where no hit) */
 #define SY_DEMOD_ARGS                                                                                                 \
     i0, i1, sn, in->color, in->albedo, in->normal, in->depth, in->position, in->direct, in->indirect, W + W_CLS * n,   \
-        W + W_OK * n, W + W_HIT * n, W + W_SN * n, W + W_Z * n, W + W_N * n, W + (W_N + 1) * n, W + (W_N + 2) * n,    \
+        W + W_OK * n, W + W_HIT * n, W + W_SN * n, W + W_Z * n, NX->nrm, NX->nrm + n, NX->nrm + 2 * n,                \
         W + W_MOD * n, W + (W_MOD + 1) * n, W + (W_MOD + 2) * n, W + W_CUR * n, W + (W_CUR + 1) * n,                 \
         W + (W_CUR + 2) * n, W + (W_CUR + 3) * n, W + (W_CUR + 4) * n, W + (W_CUR + 5) * n, W + W_LUM * n,          \
-        W + (W_LUM + 1) * n
+        W + (W_LUM + 1) * n, NX->pos, NX->pos + n, NX->pos + 2 * n
     if (in->color_channels == 4) {
         if (split) demod_c4_split(SY_DEMOD_ARGS);
         else demod_c4(SY_DEMOD_ARGS);
@@ -394,6 +420,29 @@ static void demod_rows(void *vc, uint32_t y0, uint32_t y1)
         else demod_c3(SY_DEMOD_ARGS);
     }
 #undef SY_DEMOD_ARGS
+}
+
+/* a-trous, one tap of kernel weight kk (zd: the diagonal's depth distance factor): neighbour planes
+ * (class, luminance, depth, normal, colour, variance) then the centre's (class, luminance, depth,
+ * normal, normal stop, luminance and depth stops), the sums o (colour), ow (weights), ov (variance);
+ * xmax: EXP_MAX. The class test multiplies: a select there keeps GCC from vectorising the AVX2 clone. */
+SY_TEMPORAL_CLONES
+static void atrous_tap(int x0, int x1, float kk, float zd, const float *restrict cl, const float *restrict l,
+                       const float *restrict z, const float *restrict n0, const float *restrict n1,
+                       const float *restrict n2, const float *restrict c0, const float *restrict c1,
+                       const float *restrict c2, const float *restrict v, const float *restrict ccl,
+                       const float *restrict cL, const float *restrict cZ, const float *restrict cn0,
+                       const float *restrict cn1, const float *restrict cn2, const float *restrict csn,
+                       const float *restrict cil, const float *restrict ciz, float *restrict o0, float *restrict o1,
+                       float *restrict o2, float *restrict ow, float *restrict ov, float xmax)
+{
+    for (int x = x0; x < x1; ++x) {
+        float dn = 1.0f - (cn0[x] * n0[x] + cn1[x] * n1[x] + cn2[x] * n2[x]);
+        float arg = fabsf(cL[x] - l[x]) * cil[x] + fabsf(cZ[x] - z[x]) * ciz[x] * zd + csn[x] * fmx(dn, 0.0f);
+        float k = kk * expneg(arg, xmax) * (float)(cl[x] == ccl[x]); /* e finite: 0 or e exactly */
+        o0[x] += k * c0[x], o1[x] += k * c1[x], o2[x] += k * c2[x];
+        ow[x] += k, ov[x] += k * k * v[x];
+    }
 }
 
 /* 3x3 statistics of one part, one tap: YCoCg sums s0-s2 and sums of squares s3-s5 of colour a,
@@ -424,29 +473,6 @@ static void count_tap(int x0, int x1, float axial, const float *restrict h, cons
         float m = h[x];
         cnt[x] += m;
         zg[x] = fmx(zg[x], (axial * m) * fabsf(z[x] - cz[x]));
-    }
-}
-
-/* a-trous, one tap of kernel weight kk (zd: the diagonal's depth distance factor): neighbour planes
- * (class, luminance, depth, normal, colour, variance) then the centre's (class, luminance, depth,
- * normal, normal stop, luminance and depth stops), the sums o (colour), ow (weights), ov (variance);
- * xmax: EXP_MAX. The class test multiplies: a select there keeps GCC from vectorising the AVX2 clone. */
-SY_TEMPORAL_CLONES
-static void atrous_tap(int x0, int x1, float kk, float zd, const float *restrict cl, const float *restrict l,
-                       const float *restrict z, const float *restrict n0, const float *restrict n1,
-                       const float *restrict n2, const float *restrict c0, const float *restrict c1,
-                       const float *restrict c2, const float *restrict v, const float *restrict ccl,
-                       const float *restrict cL, const float *restrict cZ, const float *restrict cn0,
-                       const float *restrict cn1, const float *restrict cn2, const float *restrict csn,
-                       const float *restrict cil, const float *restrict ciz, float *restrict o0, float *restrict o1,
-                       float *restrict o2, float *restrict ow, float *restrict ov, float xmax)
-{
-    for (int x = x0; x < x1; ++x) {
-        float dn = 1.0f - (cn0[x] * n0[x] + cn1[x] * n1[x] + cn2[x] * n2[x]);
-        float arg = fabsf(cL[x] - l[x]) * cil[x] + fabsf(cZ[x] - z[x]) * ciz[x] * zd + csn[x] * fmx(dn, 0.0f);
-        float k = kk * expneg(arg, xmax) * (float)(cl[x] == ccl[x]); /* e finite: 0 or e exactly */
-        o0[x] += k * c0[x], o1[x] += k * c1[x], o2[x] += k * c2[x];
-        ow[x] += k, ov[x] += k * k * v[x];
     }
 }
 
@@ -574,15 +600,14 @@ static inline SY_TEMPORAL_INLINE void reproject_tap(int xx, int yy, float wk, in
  * and hit h (planes); M the previous world_to_pixel, base its history (hw x hh, 17 planes hn
  * apart: illum 3, dir 3, moments 4, length, position 3, normal 3). Out: R (11 planes n apart: the
  * history, 0 where none fits) and ru (1 where reused). */
-SY_TEMPORAL_CLONES
-static void reproject_row(int w, size_t n, const float *restrict M, int hw, int hh, size_t hn,
+static void reproject_row(int xa, int w, size_t n, const float *restrict M, int hw, int hh, size_t hn,
                           const float *restrict base, float dtol, float ntol, const float *restrict pa,
                           const float *restrict pb, const float *restrict pc, const float *restrict na,
                           const float *restrict nb, const float *restrict nc, const float *restrict z,
                           const float *restrict h, float *restrict R, float *restrict ru)
 {
     float fw = (float)hw, fh = (float)hh;
-    for (int x = 0; x < w; ++x) {
+    for (int x = xa; x < w; ++x) {
         float p0 = pa[x], p1 = pb[x], p2 = pc[x], n0 = na[x], n1 = nb[x], n2 = nc[x];
         float X = M[0] * p0 + M[4] * p1 + M[8] * p2 + M[12], Y = M[1] * p0 + M[5] * p1 + M[9] * p2 + M[13];
         float Wc = M[3] * p0 + M[7] * p1 + M[11] * p2 + M[15];
@@ -612,6 +637,99 @@ static void reproject_row(int w, size_t n, const float *restrict M, int hw, int 
     }
 }
 
+#if SY_TEMPORAL_AVX2
+/* reproject_row for 8 pixels at a time with AVX2 gathers (the history's planes hold fewer than 2^31
+ * pixels): the same operations in the same order per lane as the scalar loop (0/1 products as
+ * masks, fmx / fmn as max / min, which return the second operand for NaN or equal operands as the
+ * ternaries do; no FMA), so the same results; the columns after the last group of 8 go through
+ * reproject_row. */
+__attribute__((target("avx2"))) static void reproject_row_avx2(
+    int w, size_t n, const float *restrict M, int hw, int hh, size_t hn, const float *restrict base, float dtol,
+    float ntol, const float *restrict pa, const float *restrict pb, const float *restrict pc,
+    const float *restrict na, const float *restrict nb, const float *restrict nc, const float *restrict z,
+    const float *restrict h, float *restrict R, float *restrict ru)
+{
+    const __m256 one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps(), quarter = _mm256_set1_ps(0.25f);
+    const __m256 fw = _mm256_set1_ps((float)hw), fh = _mm256_set1_ps((float)hh), eps = _mm256_set1_ps(1e-12f);
+    const __m256 m1 = _mm256_set1_ps(-1.0f), half = _mm256_set1_ps(0.5f), vdtol = _mm256_set1_ps(dtol);
+    const __m256 vntol = _mm256_set1_ps(ntol), k64 = _mm256_set1_ps(64.0f), sw_min = _mm256_set1_ps(1e-3f);
+    const __m256 sign = _mm256_set1_ps(-0.0f);
+    const __m256i izero = _mm256_setzero_si256(), ione = _mm256_set1_epi32(1), iw = _mm256_set1_epi32(hw);
+    const __m256i ih = _mm256_set1_epi32(hh), iwm = _mm256_set1_epi32(hw - 1), ihm = _mm256_set1_epi32(hh - 1);
+    __m256 Mv[16];
+    for (int k = 0; k < 16; ++k) Mv[k] = _mm256_set1_ps(M[k]);
+    const float *pos0 = base + 11 * hn, *pos1 = base + 12 * hn, *pos2 = base + 13 * hn;
+    const float *nrm0 = base + 14 * hn, *nrm1 = base + 15 * hn, *nrm2 = base + 16 * hn, *len = base + 10 * hn;
+    int x = 0;
+    for (; x + 8 <= w; x += 8) {
+        __m256 p0 = _mm256_loadu_ps(pa + x), p1 = _mm256_loadu_ps(pb + x), p2 = _mm256_loadu_ps(pc + x);
+        __m256 n0 = _mm256_loadu_ps(na + x), n1 = _mm256_loadu_ps(nb + x), n2 = _mm256_loadu_ps(nc + x);
+#define SY_PROJ(a, b, c, d)                                                                                           \
+    _mm256_add_ps(_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(Mv[a], p0), _mm256_mul_ps(Mv[b], p1)),                    \
+                                _mm256_mul_ps(Mv[c], p2)),                                                            \
+                  Mv[d])
+        __m256 X = SY_PROJ(0, 4, 8, 12), Y = SY_PROJ(1, 5, 9, 13), Wc = SY_PROJ(3, 7, 11, 15);
+#undef SY_PROJ
+        __m256 iW = _mm256_div_ps(one, _mm256_max_ps(Wc, eps));
+        __m256 fx = _mm256_sub_ps(_mm256_mul_ps(X, iW), half), fy = _mm256_sub_ps(_mm256_mul_ps(Y, iW), half);
+        __m256 vm = _mm256_and_ps(_mm256_cmp_ps(_mm256_loadu_ps(h + x), zero, _CMP_NEQ_OQ),
+                                  _mm256_cmp_ps(Wc, eps, _CMP_GT_OQ));
+        vm = _mm256_and_ps(vm, _mm256_and_ps(_mm256_cmp_ps(fx, m1, _CMP_GT_OQ), _mm256_cmp_ps(fy, m1, _CMP_GT_OQ)));
+        vm = _mm256_and_ps(vm, _mm256_and_ps(_mm256_cmp_ps(fx, fw, _CMP_LT_OQ), _mm256_cmp_ps(fy, fh, _CMP_LT_OQ)));
+        __m256 valid = _mm256_and_ps(vm, _mm256_loadu_ps(h + x)); /* h (1) where valid, else 0 */
+        fx = _mm256_max_ps(m1, _mm256_min_ps(fx, fw)), fy = _mm256_max_ps(m1, _mm256_min_ps(fy, fh));
+        __m256i x0 = _mm256_sub_epi32(_mm256_cvttps_epi32(_mm256_add_ps(fx, one)), ione);
+        __m256i y0 = _mm256_sub_epi32(_mm256_cvttps_epi32(_mm256_add_ps(fy, one)), ione);
+        __m256 ax = _mm256_sub_ps(fx, _mm256_cvtepi32_ps(x0)), ay = _mm256_sub_ps(fy, _mm256_cvtepi32_ps(y0));
+        __m256 tol = _mm256_mul_ps(vdtol, _mm256_loadu_ps(z + x)), tol2 = _mm256_mul_ps(_mm256_mul_ps(k64, tol), tol);
+        __m256 nn = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(n0, n0), _mm256_mul_ps(n1, n1)), _mm256_mul_ps(n2, n2));
+        __m256 hnc = _mm256_cmp_ps(nn, quarter, _CMP_GT_OQ); /* mask */
+        __m256 acc[11], sw = zero;
+        for (int q = 0; q < 11; ++q) acc[q] = zero;
+        __m256 bx = _mm256_sub_ps(one, ax), by = _mm256_sub_ps(one, ay);
+        for (int t = 0; t < 4; ++t) {
+            int tx = t & 1, ty = t >> 1;
+            __m256i xx = tx ? _mm256_add_epi32(x0, ione) : x0, yy = ty ? _mm256_add_epi32(y0, ione) : y0;
+            __m256 wk = _mm256_mul_ps(_mm256_mul_ps(valid, tx ? ax : bx), ty ? ay : by);
+            __m256i inb = _mm256_and_si256(_mm256_cmpgt_epi32(xx, _mm256_set1_epi32(-1)),
+                                           _mm256_cmpgt_epi32(yy, _mm256_set1_epi32(-1)));
+            inb = _mm256_and_si256(inb, _mm256_and_si256(_mm256_cmpgt_epi32(iw, xx), _mm256_cmpgt_epi32(ih, yy)));
+            __m256i xc = _mm256_min_epi32(_mm256_max_epi32(xx, izero), iwm);
+            __m256i yc = _mm256_min_epi32(_mm256_max_epi32(yy, izero), ihm);
+            __m256i j = _mm256_add_epi32(_mm256_mullo_epi32(yc, iw), xc);
+            __m256 d0 = _mm256_sub_ps(_mm256_i32gather_ps(pos0, j, 4), p0);
+            __m256 d1 = _mm256_sub_ps(_mm256_i32gather_ps(pos1, j, 4), p1);
+            __m256 d2 = _mm256_sub_ps(_mm256_i32gather_ps(pos2, j, 4), p2);
+            __m256 e0 = _mm256_i32gather_ps(nrm0, j, 4), e1 = _mm256_i32gather_ps(nrm1, j, 4);
+            __m256 e2 = _mm256_i32gather_ps(nrm2, j, 4), ln = _mm256_i32gather_ps(len, j, 4);
+            __m256 ee = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(e0, e0), _mm256_mul_ps(e1, e1)), _mm256_mul_ps(e2, e2));
+            __m256 hnj = _mm256_cmp_ps(ee, quarter, _CMP_GT_OQ);
+            __m256 dot = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(n0, e0), _mm256_mul_ps(n1, e1)), _mm256_mul_ps(n2, e2));
+            __m256 dn = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(d0, n0), _mm256_mul_ps(d1, n1)), _mm256_mul_ps(d2, n2));
+            __m256 dd = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(d0, d0), _mm256_mul_ps(d1, d1)), _mm256_mul_ps(d2, d2));
+            __m256 ok = _mm256_and_ps(_mm256_castsi256_ps(inb), _mm256_cmp_ps(ln, zero, _CMP_GT_OQ));
+            ok = _mm256_and_ps(ok, _mm256_cmp_ps(_mm256_andnot_ps(sign, dn), tol, _CMP_LE_OQ));
+            ok = _mm256_and_ps(ok, _mm256_cmp_ps(dd, tol2, _CMP_LE_OQ));
+            ok = _mm256_andnot_ps(_mm256_xor_ps(hnc, hnj), ok); /* hnc == hnj */
+            /* fmx(1 - hnc, dot >= ntol): 1 without a normal, else the test */
+            ok = _mm256_and_ps(ok, _mm256_or_ps(_mm256_xor_ps(hnc, _mm256_castsi256_ps(_mm256_set1_epi32(-1))),
+                                                _mm256_cmp_ps(dot, vntol, _CMP_GE_OQ)));
+            __m256 k = _mm256_max_ps(_mm256_and_ps(wk, ok), zero);
+            for (int q = 0; q < 10; ++q)
+                acc[q] = _mm256_add_ps(acc[q], _mm256_mul_ps(k, _mm256_i32gather_ps(base + (size_t)q * hn, j, 4)));
+            acc[10] = _mm256_add_ps(acc[10], _mm256_mul_ps(k, ln));
+            sw = _mm256_add_ps(sw, k);
+        }
+        __m256 u = _mm256_and_ps(_mm256_cmp_ps(sw, sw_min, _CMP_GT_OQ), one);
+        __m256 isw = _mm256_div_ps(u, _mm256_max_ps(sw, sw_min));
+        for (int q = 0; q < 11; ++q) _mm256_storeu_ps(R + (size_t)q * n + x, _mm256_mul_ps(acc[q], isw));
+        _mm256_storeu_ps(ru + x, u);
+    }
+    if (x < w)
+        reproject_row(x, w, n, M, hw, hh, hn, base, dtol, ntol, pa, pb, pc, na, nb, nc, z, h, R, ru);
+}
+#endif
+
 /* depth gradient, reprojection, clamping, moving averages, variance; the next history's geometry:
  * per row the 3x3 statistics (vectorised), the reprojection (scalar: 4 gathered taps per pixel),
  * then blend_row */
@@ -629,13 +747,7 @@ static void integrate_rows(void *vc, uint32_t y0, uint32_t y1)
     for (int y = (int)y0; y < (int)y1; ++y) {
         size_t row = (size_t)y * w;
         stats_row(c, y);
-        /* the next history's geometry, which is also this row's positions and normals as planes */
-        for (int x = 0; x < w; ++x) {
-            size_t i = row + x;
-            bool hit = H[i] > 0.0f;
-            const float *p = in->position + 3 * i, *nr = in->normal + 3 * i;
-            for (int q = 0; q < 3; ++q) nx->pos[q * n + i] = hit ? p[q] : 0.0f, nx->nrm[q * n + i] = hit ? nr[q] : 0.0f;
-        }
+        /* the next history's geometry (demod_rows wrote it) is also this row's positions and normals */
         /* where the surface points were at the previous frame: the positions, moved back by the
          * object motion (a non-finite motion finds no history) */
         const float *pp = nx->pos;
@@ -651,10 +763,19 @@ static void integrate_rows(void *vc, uint32_t y0, uint32_t y1)
         }
         if (c->prev) {
             const hist *hp = c->prev;
-            reproject_row(w, n, hp->world_to_pixel, (int)hp->w, (int)hp->h, (size_t)hp->w * hp->h, hp->illum,
-                          P->depth_tolerance, P->normal_tolerance, pp + row, pp + n + row, pp + 2 * n + row,
-                          nx->nrm + row, nx->nrm + n + row, nx->nrm + 2 * n + row, plane(c, W_Z) + row, H + row,
-                          R + row, RU + row);
+            size_t hn = (size_t)hp->w * hp->h;
+#if SY_TEMPORAL_AVX2
+            if (c->avx2 && hn < (size_t)1 << 31)
+                reproject_row_avx2(w, n, hp->world_to_pixel, (int)hp->w, (int)hp->h, hn, hp->illum,
+                                   P->depth_tolerance, P->normal_tolerance, pp + row, pp + n + row, pp + 2 * n + row,
+                                   nx->nrm + row, nx->nrm + n + row, nx->nrm + 2 * n + row, plane(c, W_Z) + row,
+                                   H + row, R + row, RU + row);
+            else
+#endif
+                reproject_row(0, w, n, hp->world_to_pixel, (int)hp->w, (int)hp->h, hn, hp->illum,
+                              P->depth_tolerance, P->normal_tolerance, pp + row, pp + n + row, pp + 2 * n + row,
+                              nx->nrm + row, nx->nrm + n + row, nx->nrm + 2 * n + row, plane(c, W_Z) + row, H + row,
+                              R + row, RU + row);
         } else {
             for (int q = 0; q < 11; ++q) memset(R + q * n + row, 0, (size_t)w * sizeof(float));
             memset(RU + row, 0, (size_t)w * sizeof(float));
@@ -662,8 +783,7 @@ static void integrate_rows(void *vc, uint32_t y0, uint32_t y1)
         blend_row(w, n, P->alpha, P->alpha_moments, (float)P->max_history, P->clamp_gamma, H + row,
                   plane(c, W_CUR) + row, plane(c, W_LUM) + row, stat_plane(c, 0) + row, R + row, RU + row,
                   plane(c, part_index(0, P_ACC)) + row, plane(c, part_index(0, P_ACC + 1)) + row,
-                  plane(c, part_index(0, P_ACC + 2)) + row, plane(c, part_index(1, P_ACC)) + row,
-                  plane(c, part_index(1, P_ACC + 1)) + row, plane(c, part_index(1, P_ACC + 2)) + row,
+                  plane(c, part_index(0, P_ACC + 2)) + row, nx->dir + row, nx->dir + n + row, nx->dir + 2 * n + row,
                   plane(c, part_index(0, P_VAR)) + row, plane(c, part_index(1, P_VAR)) + row,
                   plane(c, part_index(0, P_LACC)) + row, plane(c, part_index(1, P_LACC)) + row, plane(c, W_ZG) + row,
                   nx->len + row, nx->mom + row);
@@ -694,9 +814,34 @@ static void stops_row(int w, float sl, float sz, const float *restrict vw, const
     }
 }
 
+/* vblur_tap for both parts at once (the weights are the same: the class alone) */
+SY_TEMPORAL_CLONES
+static void vblur_tap2(int x0, int x1, float kk, const float *restrict cl, const float *restrict v,
+                       const float *restrict v2, const float *restrict ccl, float *restrict vb, float *restrict vb2,
+                       float *restrict vw)
+{
+    for (int x = x0; x < x1; ++x) {
+        float k = kk * (float)(cl[x] == ccl[x]);
+        vb[x] += k * v[x], vb2[x] += k * v2[x], vw[x] += k;
+    }
+}
+
+/* stops_row for both parts: il2 the direct part's luminance stop */
+SY_TEMPORAL_CLONES
+static void stops_row2(int w, float sl, float sz, const float *restrict vw, const float *restrict g,
+                       const float *restrict z, float *restrict il, float *restrict il2, float *restrict iz)
+{
+    for (int x = 0; x < w; ++x) {
+        il[x] = 1.0f / (sl * sqrtf(il[x] / vw[x]) + 1e-6f); /* vw > 0: the centre */
+        il2[x] = 1.0f / (sl * sqrtf(il2[x] / vw[x]) + 1e-6f);
+        iz[x] = 1.0f / (sz * g[x] + 1e-6f * z[x] + 1e-9f);
+    }
+}
+
 /* Before an a-trous pass: the variance blurred 3x3 (B-spline, step 1) over pixels of the centre's
  * class, turned into the pass's luminance edge stop 1 / (sigma_l sqrt(blurred) + 1e-6), and the
- * depth edge stop 1 / (sigma_z step zgrad + 1e-6 z + 1e-9) */
+ * depth edge stop 1 / (sigma_z step zgrad + 1e-6 z + 1e-9); with c->two, both parts' (the blur's
+ * weights and the depth stop are the same for both) */
 static void vblur_rows(void *vc, uint32_t y0, uint32_t y1)
 {
     static const float hk[3] = {0.25f, 0.5f, 0.25f};
@@ -708,15 +853,19 @@ static void vblur_rows(void *vc, uint32_t y0, uint32_t y1)
     float sl = P->sigma_luminance, sz = P->sigma_depth * (float)c->step;
     for (int y = (int)y0; y < (int)y1; ++y) {
         size_t row = (size_t)y * w;
-        float *vb = IL + row, *vw = WS + row;
+        float *vb = IL + row, *vw = WS + row, *vb2 = plane(c, W_IL2) + row;
         memset(vb, 0, (size_t)w * sizeof(float));
         memset(vw, 0, (size_t)w * sizeof(float));
+        if (c->two) memset(vb2, 0, (size_t)w * sizeof(float));
         tap3 taps[9];
         for (int k = 0, n = row_taps(w, hgt, y, 1, taps); k < n; ++k) {
             const tap3 *t = &taps[k];
-            vblur_tap(t->x0, t->x1, hk[t->dx + 1] * hk[t->dy + 1], cls + t->o, V + t->o, cls + row, vb, vw);
+            float kk = hk[t->dx + 1] * hk[t->dy + 1];
+            if (c->two) vblur_tap2(t->x0, t->x1, kk, cls + t->o, V + t->o, c->vsrc2 + t->o, cls + row, vb, vb2, vw);
+            else vblur_tap(t->x0, t->x1, kk, cls + t->o, V + t->o, cls + row, vb, vw);
         }
-        stops_row(w, sl, sz, vw, G + row, Z + row, IL + row, IZ + row);
+        if (c->two) stops_row2(w, sl, sz, vw, G + row, Z + row, IL + row, vb2, IZ + row);
+        else stops_row(w, sl, sz, vw, G + row, Z + row, IL + row, IZ + row);
     }
 }
 
@@ -792,21 +941,76 @@ static void atrous_row8(int x0, int x1, int s, SY_ROW3(float, cl), SY_ROW3(float
         ol[x] = h * (0.2126f * r0 + 0.7152f * r1 + 0.0722f * r2) + k * li;
     }
 }
+
+/* atrous_row8 for both parts at once (indirect: l, ca, cb, cc, v, il, o*; direct: the same with 2):
+ * the class, depth and normal terms are computed once for both, each part's sums as atrous_row8's
+ * (the same operations in the same order: the same results as two calls) */
+SY_TEMPORAL_CLONES
+static void atrous_row8_2(int x0, int x1, int s, SY_ROW3(float, cl), SY_ROW3(float, z), SY_ROW3(float, na),
+                          SY_ROW3(float, nb), SY_ROW3(float, nc), const float *restrict sn, const float *restrict iz,
+                          SY_ROW3(float, l), SY_ROW3(float, ca), SY_ROW3(float, cb), SY_ROW3(float, cc),
+                          SY_ROW3(float, v), const float *restrict il, float *restrict o0, float *restrict o1,
+                          float *restrict o2, float *restrict ov, float *restrict ol, SY_ROW3(float, l2),
+                          SY_ROW3(float, ca2), SY_ROW3(float, cb2), SY_ROW3(float, cc2), SY_ROW3(float, v2),
+                          const float *restrict il2, float *restrict p0, float *restrict p1, float *restrict p2,
+                          float *restrict pv, float *restrict pl, float xmax)
+{
+    const float kc = 0.25f, ke = 0.125f, kd = 0.0625f, dg = 0.70710678f;
+    for (int x = x0; x < x1; ++x) {
+        float ci = clm[x], zi = zm[x], n0 = nam[x], n1 = nbm[x], n2 = ncm[x], si = sn[x], iz_ = iz[x];
+        float li = lm[x], ii = il[x], li2 = l2m[x], ii2 = il2[x];
+        float a0 = kc * cam[x], a1 = kc * cbm[x], a2 = kc * ccm[x], W = kc, V = kc * kc * vm[x];
+        float b0 = kc * ca2m[x], b1 = kc * cb2m[x], b2 = kc * cc2m[x], W2 = kc, V2 = kc * kc * v2m[x];
+#define SY_TAP(R, J, KK, ZD)                                                                                          \
+    do {                                                                                                              \
+        int j_ = (J);                                                                                                 \
+        float dn = 1.0f - (n0 * na##R[j_] + n1 * nb##R[j_] + n2 * nc##R[j_]);                                         \
+        float gz = fabsf(zi - z##R[j_]) * iz_ * (ZD), gn = si * fmx(dn, 0.0f), m = (float)(cl##R[j_] == ci);         \
+        float arg = fabsf(li - l##R[j_]) * ii + gz + gn, arg2 = fabsf(li2 - l2##R[j_]) * ii2 + gz + gn;              \
+        float k = (KK) * expneg(arg, xmax) * m, k2 = (KK) * expneg(arg2, xmax) * m;                                  \
+        a0 += k * ca##R[j_], a1 += k * cb##R[j_], a2 += k * cc##R[j_];                                                \
+        W += k, V += k * k * v##R[j_];                                                                                \
+        b0 += k2 * ca2##R[j_], b1 += k2 * cb2##R[j_], b2 += k2 * cc2##R[j_];                                          \
+        W2 += k2, V2 += k2 * k2 * v2##R[j_];                                                                          \
+    } while (0)
+        SY_TAP(u, x - s, kd, dg);
+        SY_TAP(u, x, ke, 1.0f);
+        SY_TAP(u, x + s, kd, dg);
+        SY_TAP(m, x - s, ke, 1.0f);
+        SY_TAP(m, x + s, ke, 1.0f);
+        SY_TAP(d, x - s, kd, dg);
+        SY_TAP(d, x, ke, 1.0f);
+        SY_TAP(d, x + s, kd, dg);
+#undef SY_TAP
+        float h = (float)(ci > 0.0f), k = 1.0f - h, iw = 1.0f / W, iw2 = 1.0f / W2;
+        float r0 = h * (a0 * iw) + k * cam[x], r1 = h * (a1 * iw) + k * cbm[x], r2 = h * (a2 * iw) + k * ccm[x];
+        o0[x] = r0, o1[x] = r1, o2[x] = r2;
+        ov[x] = h * (V * iw * iw) + k * vm[x];
+        ol[x] = h * (0.2126f * r0 + 0.7152f * r1 + 0.0722f * r2) + k * li;
+        float q0 = h * (b0 * iw2) + k * ca2m[x], q1 = h * (b1 * iw2) + k * cb2m[x], q2 = h * (b2 * iw2) + k * cc2m[x];
+        p0[x] = q0, p1[x] = q1, p2[x] = q2;
+        pv[x] = h * (V2 * iw2 * iw2) + k * v2m[x];
+        pl[x] = h * (0.2126f * q0 + 0.7152f * q1 + 0.0722f * q2) + k * li2;
+    }
+}
 #undef SY_ROW3
 
 /* one a-trous pass (3x3 B-spline, taps c->step apart) over hits, tap by tap over each row;
  * neighbours only of the centre's class (hit with a normal, hit without one); a pixel without a hit
- * keeps its value */
+ * keeps its value. With c->two, the direct part (src2 -> dst2) in the same pass. */
 static void atrous_rows(void *vc, uint32_t y0, uint32_t y1)
 {
     static const float hk[3] = {0.25f, 0.5f, 0.25f};
     tctx *c = vc;
     size_t n = c->n;
-    int w = (int)c->in->width, hgt = (int)c->in->height, s = c->step;
-    const float *cls = plane(c, W_CLS), *H = plane(c, W_HIT), *L = c->lsrc, *Z = plane(c, W_Z);
-    const float *N0 = plane(c, W_N), *N1 = plane(c, W_N + 1), *N2 = plane(c, W_N + 2);
-    const float *SN = plane(c, W_SN), *IL = plane(c, W_IL), *IZ = plane(c, W_IZ);
-    const float *C0 = c->src, *C1 = c->src + n, *C2 = c->src + 2 * n, *V = c->vsrc;
+    int w = (int)c->in->width, hgt = (int)c->in->height, s = c->step, parts = c->two ? 2 : 1;
+    const float *cls = plane(c, W_CLS), *H = plane(c, W_HIT), *Z = plane(c, W_Z);
+    const float *N0 = c->next->nrm, *N1 = c->next->nrm + n, *N2 = c->next->nrm + 2 * n;
+    const float *SN = plane(c, W_SN), *IZ = plane(c, W_IZ);
+    /* per part: luminance, colour 3, variance, luminance stop; the outputs */
+    const float *PL[2] = {c->lsrc, c->lsrc2}, *PC[2] = {c->src, c->src2}, *PV[2] = {c->vsrc, c->vsrc2};
+    const float *PIL[2] = {plane(c, W_IL), plane(c, W_IL2)};
+    float *PD[2] = {c->dst, c->dst2}, *PDV[2] = {c->vdst, c->vdst2}, *PDL[2] = {c->ldst, c->ldst2};
     const float *neg = c->t->dummy, *zero = c->t->dummy + w; /* a row outside the image */
     float *WS = plane(c, W_WS);
     const float k0 = hk[1] * hk[1]; /* the centre: exactly its kernel weight */
@@ -815,61 +1019,102 @@ static void atrous_rows(void *vc, uint32_t y0, uint32_t y1)
     int xa = s < w ? s : w, xb = w - s > xa ? w - s : xa;
     for (int y = (int)y0; y < (int)y1; ++y) {
         size_t row = (size_t)y * w;
-        float *o0 = c->dst + row, *o1 = c->dst + n + row, *o2 = c->dst + 2 * n + row;
-        float *ov = c->vdst + row, *ow = WS + row, *ol = c->ldst + row;
         if (xb > xa) {
-            const float *P[10][3]; /* class, luminance, depth, normal 3, colour 3, variance: rows u, m, d */
+            /* class, depth, normal 3; per part luminance, colour 3, variance: rows u, m, d */
+            const float *P[15][3];
             for (int r = 0; r < 3; ++r) {
                 int yy = y + (r - 1) * s;
                 bool in = yy >= 0 && yy < hgt;
                 size_t o = in ? (size_t)yy * w : 0;
-                const float *src[10] = {cls, L, Z, N0, N1, N2, C0, C1, C2, V};
-                for (int q = 0; q < 10; ++q) P[q][r] = in ? src[q] + o : (q == 0 ? neg : zero);
+                const float *src[15] = {cls,       Z,         N0,        N1,        N2,
+                                        PL[0],     PC[0],     PC[0] + n, PC[0] + 2 * n, PV[0],
+                                        PL[1],     PC[1],     PC[1] + n, PC[1] + 2 * n, PV[1]};
+                for (int q = 0; q < 5 + 5 * parts; ++q) P[q][r] = in ? src[q] + o : (q == 0 ? neg : zero);
             }
-            atrous_row8(xa, xb, s, P[0][0], P[0][1], P[0][2], P[1][0], P[1][1], P[1][2], P[2][0], P[2][1], P[2][2],
-                        P[3][0], P[3][1], P[3][2], P[4][0], P[4][1], P[4][2], P[5][0], P[5][1], P[5][2], P[6][0],
-                        P[6][1], P[6][2], P[7][0], P[7][1], P[7][2], P[8][0], P[8][1], P[8][2], P[9][0], P[9][1],
-                        P[9][2], SN + row, IL + row, IZ + row, o0, o1, o2, ov, ol, c->xmax);
+            float *o0 = PD[0] + row, *o1 = PD[0] + n + row, *o2 = PD[0] + 2 * n + row;
+            float *ov = PDV[0] + row, *ol = PDL[0] + row;
+#define SY_R3(q) P[q][0], P[q][1], P[q][2]
+            if (parts == 2)
+                atrous_row8_2(xa, xb, s, SY_R3(0), SY_R3(1), SY_R3(2), SY_R3(3), SY_R3(4), SN + row, IZ + row, SY_R3(5),
+                              SY_R3(6), SY_R3(7), SY_R3(8), SY_R3(9), PIL[0] + row, o0, o1, o2, ov, ol, SY_R3(10),
+                              SY_R3(11), SY_R3(12), SY_R3(13), SY_R3(14), PIL[1] + row, PD[1] + row, PD[1] + n + row,
+                              PD[1] + 2 * n + row, PDV[1] + row, PDL[1] + row, c->xmax);
+            else
+                atrous_row8(xa, xb, s, SY_R3(0), SY_R3(5), SY_R3(1), SY_R3(2), SY_R3(3), SY_R3(4), SY_R3(6), SY_R3(7),
+                            SY_R3(8), SY_R3(9), SN + row, PIL[0] + row, IZ + row, o0, o1, o2, ov, ol, c->xmax);
+#undef SY_R3
         }
-        for (int e = 0; e < 2; ++e) { /* the edges [0, xa) and [xb, w) */
-            int ea = e ? xb : 0, eb = e ? w : xa;
-            if (eb <= ea) continue;
-            atrous_start(eb - ea, k0, C0 + row + ea, C1 + row + ea, C2 + row + ea, V + row + ea, o0 + ea, o1 + ea,
-                         o2 + ea, ow + ea, ov + ea);
-            tap3 taps[9];
-            for (int k = 0, n = row_taps(w, hgt, y, s, taps); k < n; ++k) {
-                int dx = taps[k].dx, dy = taps[k].dy;
-                if (dx == 0 && dy == 0) continue;
-                int x0 = taps[k].x0 > ea ? taps[k].x0 : ea, x1 = taps[k].x1 < eb ? taps[k].x1 : eb;
-                if (x1 <= x0) continue;
-                size_t o = taps[k].o;
-                float kk = hk[dx + 1] * hk[dy + 1], zd = (dx && dy) ? 0.70710678f : 1.0f;
-                atrous_tap(x0, x1, kk, zd, cls + o, L + o, Z + o, N0 + o, N1 + o, N2 + o, C0 + o, C1 + o, C2 + o, V + o,
-                           cls + row, L + row, Z + row, N0 + row, N1 + row, N2 + row, SN + row, IL + row, IZ + row, o0,
-                           o1, o2, ow, ov, c->xmax);
+        for (int k = 0; k < parts; ++k) {
+            const float *L = PL[k], *C0 = PC[k], *C1 = PC[k] + n, *C2 = PC[k] + 2 * n, *V = PV[k], *IL = PIL[k];
+            float *o0 = PD[k] + row, *o1 = PD[k] + n + row, *o2 = PD[k] + 2 * n + row;
+            float *ov = PDV[k] + row, *ow = WS + row, *ol = PDL[k] + row;
+            for (int e = 0; e < 2; ++e) { /* the edges [0, xa) and [xb, w) */
+                int ea = e ? xb : 0, eb = e ? w : xa;
+                if (eb <= ea) continue;
+                atrous_start(eb - ea, k0, C0 + row + ea, C1 + row + ea, C2 + row + ea, V + row + ea, o0 + ea,
+                             o1 + ea, o2 + ea, ow + ea, ov + ea);
+                tap3 taps[9];
+                for (int t = 0, nt = row_taps(w, hgt, y, s, taps); t < nt; ++t) {
+                    int dx = taps[t].dx, dy = taps[t].dy;
+                    if (dx == 0 && dy == 0) continue;
+                    int x0 = taps[t].x0 > ea ? taps[t].x0 : ea, x1 = taps[t].x1 < eb ? taps[t].x1 : eb;
+                    if (x1 <= x0) continue;
+                    size_t o = taps[t].o;
+                    float kk = hk[dx + 1] * hk[dy + 1], zd = (dx && dy) ? 0.70710678f : 1.0f;
+                    atrous_tap(x0, x1, kk, zd, cls + o, L + o, Z + o, N0 + o, N1 + o, N2 + o, C0 + o, C1 + o, C2 + o,
+                               V + o, cls + row, L + row, Z + row, N0 + row, N1 + row, N2 + row, SN + row, IL + row,
+                               IZ + row, o0, o1, o2, ow, ov, c->xmax);
+                }
+                atrous_end(eb - ea, H + row + ea, C0 + row + ea, C1 + row + ea, C2 + row + ea, V + row + ea,
+                           L + row + ea, ow + ea, o0 + ea, o1 + ea, o2 + ea, ov + ea, ol + ea);
             }
-            atrous_end(eb - ea, H + row + ea, C0 + row + ea, C1 + row + ea, C2 + row + ea, V + row + ea, L + row + ea,
-                       ow + ea, o0 + ea, o1 + ea, o2 + ea, ov + ea, ol + ea);
         }
     }
+}
+
+/* remodulation of pixels [0, w) of a row: out (RGBA, 4 floats per pixel) and the estimate's planes
+ * e0-e2 = (a + b) x m (the parts' filtered planes, the albedo), e3 the samples the estimate counts
+ * as (remod_rows); alpha from col (stride 4) where finite, else 1 (col NULL: 3 channels, 1) */
+SY_TEMPORAL_CLONES
+static void remod_row(int w, const float *restrict a0, const float *restrict a1, const float *restrict a2,
+                      const float *restrict b0, const float *restrict b1, const float *restrict b2,
+                      const float *restrict m0, const float *restrict m1, const float *restrict m2,
+                      const float *restrict var0, const float *restrict vout, const float *restrict len,
+                      const float *restrict col, float *restrict out, float *restrict e0, float *restrict e1,
+                      float *restrict e2, float *restrict e3)
+{
+    for (int x = 0; x < w; ++x) {
+        float r = (a0[x] + b0[x]) * m0[x], g_ = (a1[x] + b1[x]) * m1[x], b = (a2[x] + b2[x]) * m2[x];
+        e0[x] = r, e1[x] = g_, e2[x] = b;
+        out[4 * x] = r, out[4 * x + 1] = g_, out[4 * x + 2] = b;
+        /* the samples the estimate counts as: its history length times the variance reduction of
+         * the a-trous passes (blended variance / filtered variance of the indirect part or colour),
+         * the latter within [1, 64] */
+        float v0 = var0[x], v1 = vout[x], g = v1 > 0.0f ? v0 / v1 : 1.0f;
+        e3[x] = len[x] * fmn(fmx(g, 1.0f), 64.0f);
+    }
+    if (col)
+        for (int x = 0; x < w; ++x) {
+            float al = col[4 * x + 3];
+            out[4 * x + 3] = nonfinite0(al) == 0.0f ? al : 1.0f;
+        }
+    else
+        for (int x = 0; x < w; ++x) out[4 * x + 3] = 1.0f;
 }
 
 static void remod_rows(void *vc, uint32_t y0, uint32_t y1)
 {
     tctx *c = vc;
     const sy_filter_frame *in = c->in;
-    size_t w = in->width, cc = in->color_channels, n = c->n;
+    size_t w = in->width, n = c->n;
     const float *m = plane(c, W_MOD), *a = c->outp[0], *b = c->outp[1];
     float *est = c->t->est;
-    for (size_t i = (size_t)y0 * w; i < (size_t)y1 * w; ++i) {
-        float *o = c->out + 4 * i;
-        for (int q = 0; q < 3; ++q) est[q * n + i] = o[q] = (a[q * n + i] + b[q * n + i]) * m[q * n + i];
-        /* the samples the estimate counts as: its history length times the variance reduction of
-         * the a-trous passes (blended variance / filtered variance of the indirect part or colour),
-         * the latter within [1, 64] */
-        float v0 = c->var0[i], v1 = c->vout[0][i], g = v1 > 0.0f ? v0 / v1 : 1.0f;
-        est[3 * n + i] = c->next->len[i] * fmn(fmx(g, 1.0f), 64.0f);
-        o[3] = cc == 4 && isfinite(in->color[4 * i + 3]) ? in->color[4 * i + 3] : 1.0f;
+    for (size_t y = y0; y < y1; ++y) {
+        size_t i = y * w;
+        remod_row((int)w, a + i, a + n + i, a + 2 * n + i, b + i, b + n + i, b + 2 * n + i, m + i, m + n + i,
+                  m + 2 * n + i, c->var0 + i, c->vout[0] + i, c->next->len + i,
+                  in->color_channels == 4 ? in->color + 4 * i : NULL, c->out + 4 * i, est + i, est + n + i,
+                  est + 2 * n + i, est + 3 * n + i);
     }
 }
 
@@ -912,6 +1157,9 @@ sy_filter_status sy_filter_temporal_run(sy_filter_temporal *t, const sy_filter_f
     hist_bind(nx, n);
     tctx c = {.t = t, .in = in, .prev = t->have_prev ? &t->h[t->prev] : NULL, .next = nx, .n = n, .W = t->work,
               .xmax = EXP_MAX, .out = out};
+#if SY_TEMPORAL_AVX2
+    c.avx2 = __builtin_cpu_supports("avx2");
+#endif
     uint32_t th = t->p.threads, rows = in->height;
     double ph[5];
     ph[0] = sy_filter_clock(false);
@@ -919,31 +1167,34 @@ sy_filter_status sy_filter_temporal_run(sy_filter_temporal *t, const sy_filter_f
     ph[1] = sy_filter_clock(false);
     sy_filter_parallel_rows(th, rows, integrate_rows, &c);
     ph[2] = sy_filter_clock(false);
-    /* the a-trous passes: the indirect part (or the colour), then the direct part when split */
+    /* the a-trous passes: the indirect part (or the colour), and the direct part when split, both in
+     * the same passes. The next history: the first pass's output for the indirect part (as SVGF),
+     * written there directly; the direct part's unfiltered blend (fed back, its filtered output let
+     * emitter light creep over their edges frame after frame: Cornell box relMSE 0.077 against 0.023,
+     * `sy bench temporal`, 16 frames), which integrate_rows wrote there. */
     bool split = in->direct && in->indirect;
-    for (int k = 0; k < 2; ++k) {
-#define Q(off) plane(&c, part_index(k, off))
-        const float *src = Q(P_ACC), *vsrc = Q(P_VAR), *lsrc = Q(P_LACC);
-        uint32_t iters = k == 0 || split ? t->p.atrous_iterations : 0;
-        /* the next history: the first pass's output for the indirect part (as SVGF); the direct part's
-         * unfiltered blend (fed back, its filtered output let emitter light creep over their edges
-         * frame after frame: Cornell box relMSE 0.077 against 0.023, `sy bench temporal`, 16 frames) */
-        bool feed = k == 0;
-        float *keep = k == 0 ? nx->illum : nx->dir;
-        if (iters == 0 || !feed) memcpy(keep, src, 3 * n * sizeof(float));
-        for (uint32_t it = 0; it < iters; ++it) {
-            c.src = src, c.vsrc = vsrc, c.lsrc = lsrc;
-            c.dst = Q((it & 1) ? P_B : P_A), c.vdst = Q((it & 1) ? P_VB : P_VA), c.ldst = Q((it & 1) ? P_LB : P_LA);
-            c.step = 1 << it;
-            sy_filter_parallel_rows(th, rows, vblur_rows, &c);
-            sy_filter_parallel_rows(th, rows, atrous_rows, &c);
-            if (it == 0 && feed) memcpy(keep, c.dst, 3 * n * sizeof(float));
-            src = c.dst, vsrc = c.vdst, lsrc = c.ldst;
+    uint32_t iters = t->p.atrous_iterations;
+    const float *src[2] = {plane(&c, part_index(0, P_ACC)), nx->dir};
+    const float *vsrc[2] = {plane(&c, part_index(0, P_VAR)), plane(&c, part_index(1, P_VAR))};
+    const float *lsrc[2] = {plane(&c, part_index(0, P_LACC)), plane(&c, part_index(1, P_LACC))};
+    if (iters == 0) memcpy(nx->illum, src[0], 3 * n * sizeof(float));
+    c.two = split;
+    for (uint32_t it = 0; it < iters; ++it) {
+        float *dst[2], *vdst[2], *ldst[2];
+        for (int k = 0; k < 2; ++k) {
+            dst[k] = it == 0 && k == 0 ? nx->illum : plane(&c, part_index(k, (it & 1) ? P_B : P_A));
+            vdst[k] = plane(&c, part_index(k, (it & 1) ? P_VB : P_VA));
+            ldst[k] = plane(&c, part_index(k, (it & 1) ? P_LB : P_LA));
         }
-        c.outp[k] = src;
-        c.vout[k] = vsrc;
-#undef Q
+        c.src = src[0], c.vsrc = vsrc[0], c.lsrc = lsrc[0], c.dst = dst[0], c.vdst = vdst[0], c.ldst = ldst[0];
+        c.src2 = src[1], c.vsrc2 = vsrc[1], c.lsrc2 = lsrc[1], c.dst2 = dst[1], c.vdst2 = vdst[1], c.ldst2 = ldst[1];
+        c.step = 1 << it;
+        sy_filter_parallel_rows(th, rows, vblur_rows, &c);
+        sy_filter_parallel_rows(th, rows, atrous_rows, &c);
+        for (int k = 0; k < (split ? 2 : 1); ++k) src[k] = dst[k], vsrc[k] = vdst[k], lsrc[k] = ldst[k];
     }
+    c.outp[0] = src[0], c.outp[1] = src[1];
+    c.vout[0] = vsrc[0], c.vout[1] = vsrc[1];
     c.var0 = plane(&c, part_index(0, P_VAR));
     ph[3] = sy_filter_clock(false);
     sy_filter_parallel_rows(th, rows, remod_rows, &c);

@@ -28,6 +28,7 @@ static void rt_destroy(void *state)
         sy_radiance_hook_destroy(st->slots[i].radiance);
     }
     for (int k = 0; k <= SY_RT_AOV_COUNT; ++k) free(st->fbuf[k]);
+    free(st->fcol);
     sy_rti_temporal_free(st);
     sy_rt_device_destroy(st->dev);
     sy_mirror_map_free(&st->inst_node);

@@ -257,8 +257,9 @@ void sy_mediator_rt_filter_info_get(void *state, sy_mediator_rt_filter_info *out
 
 /* World positions of the first hits of rows [y0, y1) of the rectangle's pixels from the camera-axis
  * depth (the a-trous guide and the headlight of the pixel filter's range buffer); misses go 1e18
- * away. */
-static void filter_positions(const sy_render_request *req, const float *depth, float *pos, uint32_t y0, uint32_t y1)
+ * away. ucol: each column's window x (column_u). */
+static void filter_positions(const sy_render_request *req, const float *ucol, const float *depth, float *pos,
+                             uint32_t y0, uint32_t y1)
 {
     const sy_camera_view *v = &req->camera;
     const float *m = v->camera_to_world.m;
@@ -267,7 +268,7 @@ static void filter_positions(const sy_render_request *req, const float *depth, f
         float w = v->window[3] - (v->window[3] - v->window[2]) * ((float)(req->rect_y + y) + 0.5f) / (float)req->full_height;
         for (uint32_t x = 0; x < req->rect_w; ++x) {
             size_t i = (size_t)y * req->rect_w + x;
-            float u = v->window[0] + (v->window[1] - v->window[0]) * ((float)(req->rect_x + x) + 0.5f) / (float)req->full_width;
+            float u = ucol[x];
             float d = depth[i];
             if (!isfinite(d)) d = 1e18f;
             float c[3] = {ortho ? u : u * d, ortho ? w : w * d, -d};
@@ -276,12 +277,21 @@ static void filter_positions(const sy_render_request *req, const float *depth, f
     }
 }
 
+/* the window x of the rectangle's column centres (filter_positions) */
+static void column_u(const sy_render_request *req, float *ucol)
+{
+    const sy_camera_view *v = &req->camera;
+    for (uint32_t x = 0; x < req->rect_w; ++x)
+        ucol[x] = v->window[0] + (v->window[1] - v->window[0]) * ((float)(req->rect_x + x) + 0.5f) / (float)req->full_width;
+}
+
 /* the rows of sy_rti_filter_read_aovs: the feature buffers in one pass, then the positions */
 typedef struct read_rows_ctx {
     const sy_rt_accum *acc;
     const sy_render_request *req;
     float *out[SY_RT_AOV_COUNT];
-    float *pos; /* NULL: none */
+    float *pos;        /* NULL: none */
+    const float *ucol; /* column_u */
     _Atomic int failed;
 } read_rows_ctx;
 
@@ -292,7 +302,7 @@ static void read_rows(void *vc, uint32_t y0, uint32_t y1)
         atomic_store(&c->failed, 1);
         return;
     }
-    if (c->pos) filter_positions(c->req, c->out[SY_RT_AOV_DEPTH], c->pos, y0, y1);
+    if (c->pos) filter_positions(c->req, c->ucol, c->out[SY_RT_AOV_DEPTH], c->pos, y0, y1);
 }
 
 /* Reads the slot's feature buffers (rect_w x rect_h) into st->fbuf (the filters' inputs): the variance
@@ -320,7 +330,16 @@ sy_result sy_rti_filter_read_aovs(rt_state *st, const accum_slot *a, const sy_re
     if (aw != req->rect_w || ah != req->rect_h) /* the slot is the request's rectangle (sy_rti_pt_slot) */
         return sy_error_set(err, SY_ERR_BACKEND, "pathtracer filter: feature buffers of %ux%u for a %ux%u rectangle",
                             aw, ah, req->rect_w, req->rect_h);
-    read_rows_ctx c = {.acc = a->acc, .req = req, .pos = positions ? st->fbuf[SY_RT_AOV_COUNT] : NULL};
+    if (positions && req->rect_w > st->fcol_cap) {
+        free(st->fcol);
+        st->fcol = malloc(req->rect_w * sizeof *st->fcol);
+        st->fcol_cap = st->fcol ? req->rect_w : 0;
+        if (!st->fcol)
+            return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "pathtracer filter: out of memory for %ux%u", req->rect_w,
+                                req->rect_h);
+    }
+    if (positions) column_u(req, st->fcol);
+    read_rows_ctx c = {.acc = a->acc, .req = req, .pos = positions ? st->fbuf[SY_RT_AOV_COUNT] : NULL, .ucol = st->fcol};
     for (int k = 0; k < SY_RT_AOV_COUNT; ++k) c.out[k] = k == SY_RT_AOV_VARIANCE && !variance ? NULL : st->fbuf[k];
     atomic_init(&c.failed, 0);
     sy_filter_parallel_rows(st->filter.atrous.threads, ah, read_rows, &c);

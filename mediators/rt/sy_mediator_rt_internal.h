@@ -130,6 +130,8 @@ typedef struct rt_state {
     pt_filter_cfg filter;          /* path tracer display filter */
     float *fbuf[SY_RT_AOV_COUNT + 1]; /* filter inputs: the AOV planes + world positions */
     size_t fbuf_px;                /* pixels the fbuf planes hold */
+    float *fcol;                   /* per column of the rectangle: its pixel centres' window x (positions) */
+    size_t fcol_cap;
     sy_mediator_rt_filter_info finfo; /* last filtered frame */
     /* temporal reuse (filter.temporal): one history per context, fed by every path-traced render
      * whose camera differs from the previous render's (temporal_cam), or (filter.temporal_motion)
