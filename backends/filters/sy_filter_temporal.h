@@ -15,7 +15,8 @@
  *   1. reprojection: the point's previous position q_i = p_i + motion_i (frame.motion, the object
  *      motion since the previous frame; q_i = p_i without it; a non-finite motion finds no
  *      history, and is not counted as a bad pixel; the path tracer's mediator gives it for the
- *      instances moved since its previous render: temporal_motion in sy_mediator_rt.h) through the
+ *      instances moved since its previous render and, per vertex, for the hits on skinned or
+ *      morphed meshes that deformed: temporal_motion, temporal_deform in sy_mediator_rt.h) through the
  *      previous camera (prev world_to_pixel), bilinear over its 4 nearest pixel centres; a tap counts only when its stored
  *      world position lies within depth_tolerance x depth_i of q_i and its normal within
  *      normal_tolerance (cosine) of n_i (a surface that turned further in one frame starts anew). No
