@@ -11,9 +11,9 @@
  * another class (hit with a normal, hit without one, none) gets weight 0 through a select. Per
  * pixel, the taps are summed in the order the scalar version summed them (centre, then dy, dx
  * row-major), so results do not depend on the vector width or the thread count. The reprojection
- * (4 gathered taps of the previous history per pixel), which GCC does not vectorise, has AVX-512
- * and AVX2 versions written with gathers (reproject_row_avx512, reproject_row_avx2: the same
- * operations per lane) beside the scalar loop. Passes that stream the same planes run together: the direct and indirect parts share each
+ * (4 gathered taps of the previous history per pixel), which GCC does not vectorise, has an AVX2
+ * version written with gathers (reproject_row_avx2, the same operations per lane) beside the scalar
+ * loop. Passes that stream the same planes run together: the direct and indirect parts share each
  * variance blur and a-trous pass (atrous_row8_2: the class, depth and normal terms once; the 3x3
  * statistics of both parts in one loop took more instructions, 31 M against 27 M a frame: the
  * loop's 30 streams spill registers), the demodulation writes the next history's positions and
@@ -49,8 +49,8 @@
 #else
 #define SY_TEMPORAL_CLONES
 #endif
-/* the reprojection's gathers, written with AVX-512 and AVX2 intrinsics (GCC does not vectorise
- * them), picked at run time */
+/* the reprojection's gathers, written with AVX2 intrinsics (GCC does not vectorise them), picked at
+ * run time */
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #define SY_TEMPORAL_AVX2 1
 #include <immintrin.h>
@@ -287,7 +287,6 @@ typedef struct tctx {
     int step;
     float xmax; /* EXP_MAX, through memory (see expneg) */
     bool avx2;  /* the CPU has AVX2 (reproject_row_avx2) */
-    bool avx512; /* and AVX-512F (reproject_row_avx512) */
     const float *outp[2]; /* the parts' final planes (remodulation) */
     const float *vout[2]; /* their final variance */
     const float *var0;    /* the indirect part's (or colour's) variance before the a-trous passes */
@@ -731,91 +730,6 @@ __attribute__((target("avx2"))) static void reproject_row_avx2(
     if (x < w)
         reproject_row(x, w, n, M, hw, hh, hn, base, dtol, ntol, pa, pb, pc, na, nb, nc, z, h, R, ru);
 }
-
-/* reproject_row_avx2 with 16 lanes (AVX-512F; comparisons as mask registers, the same operations per
- * lane: the same results) */
-__attribute__((target("avx512f"))) static void reproject_row_avx512(
-    int w, size_t n, const float *restrict M, int hw, int hh, size_t hn, const float *restrict base, float dtol,
-    float ntol, const float *restrict pa, const float *restrict pb, const float *restrict pc,
-    const float *restrict na, const float *restrict nb, const float *restrict nc, const float *restrict z,
-    const float *restrict h, float *restrict R, float *restrict ru)
-{
-    const __m512 one = _mm512_set1_ps(1.0f), zero = _mm512_setzero_ps(), quarter = _mm512_set1_ps(0.25f);
-    const __m512 fw = _mm512_set1_ps((float)hw), fh = _mm512_set1_ps((float)hh), eps = _mm512_set1_ps(1e-12f);
-    const __m512 m1 = _mm512_set1_ps(-1.0f), half = _mm512_set1_ps(0.5f), vdtol = _mm512_set1_ps(dtol);
-    const __m512 vntol = _mm512_set1_ps(ntol), k64 = _mm512_set1_ps(64.0f), sw_min = _mm512_set1_ps(1e-3f);
-    const __m512i izero = _mm512_setzero_si512(), ione = _mm512_set1_epi32(1), iw = _mm512_set1_epi32(hw);
-    const __m512i ih = _mm512_set1_epi32(hh), iwm = _mm512_set1_epi32(hw - 1), ihm = _mm512_set1_epi32(hh - 1);
-    const __m512i ineg = _mm512_set1_epi32(-1);
-    __m512 Mv[16];
-    for (int k = 0; k < 16; ++k) Mv[k] = _mm512_set1_ps(M[k]);
-    const float *pos0 = base + 11 * hn, *pos1 = base + 12 * hn, *pos2 = base + 13 * hn;
-    const float *nrm0 = base + 14 * hn, *nrm1 = base + 15 * hn, *nrm2 = base + 16 * hn, *len = base + 10 * hn;
-    int x = 0;
-    for (; x + 16 <= w; x += 16) {
-        __m512 p0 = _mm512_loadu_ps(pa + x), p1 = _mm512_loadu_ps(pb + x), p2 = _mm512_loadu_ps(pc + x);
-        __m512 n0 = _mm512_loadu_ps(na + x), n1 = _mm512_loadu_ps(nb + x), n2 = _mm512_loadu_ps(nc + x);
-#define SY_PROJ(a, b, c, d)                                                                                           \
-    _mm512_add_ps(_mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(Mv[a], p0), _mm512_mul_ps(Mv[b], p1)),                    \
-                                _mm512_mul_ps(Mv[c], p2)),                                                            \
-                  Mv[d])
-        __m512 X = SY_PROJ(0, 4, 8, 12), Y = SY_PROJ(1, 5, 9, 13), Wc = SY_PROJ(3, 7, 11, 15);
-#undef SY_PROJ
-        __m512 iW = _mm512_div_ps(one, _mm512_max_ps(Wc, eps));
-        __m512 fx = _mm512_sub_ps(_mm512_mul_ps(X, iW), half), fy = _mm512_sub_ps(_mm512_mul_ps(Y, iW), half);
-        __m512 hv = _mm512_loadu_ps(h + x);
-        __mmask16 vm = _mm512_cmp_ps_mask(hv, zero, _CMP_NEQ_OQ) & _mm512_cmp_ps_mask(Wc, eps, _CMP_GT_OQ);
-        vm &= _mm512_cmp_ps_mask(fx, m1, _CMP_GT_OQ) & _mm512_cmp_ps_mask(fy, m1, _CMP_GT_OQ);
-        vm &= _mm512_cmp_ps_mask(fx, fw, _CMP_LT_OQ) & _mm512_cmp_ps_mask(fy, fh, _CMP_LT_OQ);
-        __m512 valid = _mm512_maskz_mov_ps(vm, hv); /* h (1) where valid, else 0 */
-        fx = _mm512_max_ps(m1, _mm512_min_ps(fx, fw)), fy = _mm512_max_ps(m1, _mm512_min_ps(fy, fh));
-        __m512i x0 = _mm512_sub_epi32(_mm512_cvttps_epi32(_mm512_add_ps(fx, one)), ione);
-        __m512i y0 = _mm512_sub_epi32(_mm512_cvttps_epi32(_mm512_add_ps(fy, one)), ione);
-        __m512 ax = _mm512_sub_ps(fx, _mm512_cvtepi32_ps(x0)), ay = _mm512_sub_ps(fy, _mm512_cvtepi32_ps(y0));
-        __m512 tol = _mm512_mul_ps(vdtol, _mm512_loadu_ps(z + x)), tol2 = _mm512_mul_ps(_mm512_mul_ps(k64, tol), tol);
-        __m512 nn = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(n0, n0), _mm512_mul_ps(n1, n1)), _mm512_mul_ps(n2, n2));
-        __mmask16 hnc = _mm512_cmp_ps_mask(nn, quarter, _CMP_GT_OQ);
-        __m512 acc[11], sw = zero;
-        for (int q = 0; q < 11; ++q) acc[q] = zero;
-        __m512 bx = _mm512_sub_ps(one, ax), by = _mm512_sub_ps(one, ay);
-        for (int t = 0; t < 4; ++t) {
-            int tx = t & 1, ty = t >> 1;
-            __m512i xx = tx ? _mm512_add_epi32(x0, ione) : x0, yy = ty ? _mm512_add_epi32(y0, ione) : y0;
-            __m512 wk = _mm512_mul_ps(_mm512_mul_ps(valid, tx ? ax : bx), ty ? ay : by);
-            __mmask16 inb = _mm512_cmpgt_epi32_mask(xx, ineg) & _mm512_cmpgt_epi32_mask(yy, ineg) &
-                            _mm512_cmpgt_epi32_mask(iw, xx) & _mm512_cmpgt_epi32_mask(ih, yy);
-            __m512i xc = _mm512_min_epi32(_mm512_max_epi32(xx, izero), iwm);
-            __m512i yc = _mm512_min_epi32(_mm512_max_epi32(yy, izero), ihm);
-            __m512i j = _mm512_add_epi32(_mm512_mullo_epi32(yc, iw), xc);
-            __m512 d0 = _mm512_sub_ps(_mm512_i32gather_ps(j, pos0, 4), p0);
-            __m512 d1 = _mm512_sub_ps(_mm512_i32gather_ps(j, pos1, 4), p1);
-            __m512 d2 = _mm512_sub_ps(_mm512_i32gather_ps(j, pos2, 4), p2);
-            __m512 e0 = _mm512_i32gather_ps(j, nrm0, 4), e1 = _mm512_i32gather_ps(j, nrm1, 4);
-            __m512 e2 = _mm512_i32gather_ps(j, nrm2, 4), ln = _mm512_i32gather_ps(j, len, 4);
-            __m512 ee = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(e0, e0), _mm512_mul_ps(e1, e1)), _mm512_mul_ps(e2, e2));
-            __mmask16 hnj = _mm512_cmp_ps_mask(ee, quarter, _CMP_GT_OQ);
-            __m512 dot = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(n0, e0), _mm512_mul_ps(n1, e1)), _mm512_mul_ps(n2, e2));
-            __m512 dn = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(d0, n0), _mm512_mul_ps(d1, n1)), _mm512_mul_ps(d2, n2));
-            __m512 dd = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(d0, d0), _mm512_mul_ps(d1, d1)), _mm512_mul_ps(d2, d2));
-            __mmask16 ok = inb & _mm512_cmp_ps_mask(ln, zero, _CMP_GT_OQ);
-            ok &= _mm512_cmp_ps_mask(_mm512_abs_ps(dn), tol, _CMP_LE_OQ) & _mm512_cmp_ps_mask(dd, tol2, _CMP_LE_OQ);
-            ok &= (__mmask16)~(hnc ^ hnj); /* hnc == hnj */
-            ok &= (__mmask16)(~hnc | _mm512_cmp_ps_mask(dot, vntol, _CMP_GE_OQ)); /* fmx(1 - hnc, dot >= ntol) */
-            __m512 k = _mm512_max_ps(_mm512_maskz_mov_ps(ok, wk), zero);
-            for (int q = 0; q < 10; ++q)
-                acc[q] = _mm512_add_ps(acc[q], _mm512_mul_ps(k, _mm512_i32gather_ps(j, base + (size_t)q * hn, 4)));
-            acc[10] = _mm512_add_ps(acc[10], _mm512_mul_ps(k, ln));
-            sw = _mm512_add_ps(sw, k);
-        }
-        __m512 u = _mm512_maskz_mov_ps(_mm512_cmp_ps_mask(sw, sw_min, _CMP_GT_OQ), one);
-        __m512 isw = _mm512_div_ps(u, _mm512_max_ps(sw, sw_min));
-        for (int q = 0; q < 11; ++q) _mm512_storeu_ps(R + (size_t)q * n + x, _mm512_mul_ps(acc[q], isw));
-        _mm512_storeu_ps(ru + x, u);
-    }
-    if (x < w)
-        reproject_row_avx2(w - x, n, M, hw, hh, hn, base, dtol, ntol, pa + x, pb + x, pc + x, na + x, nb + x, nc + x,
-                           z + x, h + x, R + x, ru + x);
-}
 #endif
 
 /* depth gradient, reprojection, clamping, moving averages, variance; the next history's geometry:
@@ -853,12 +767,7 @@ static void integrate_rows(void *vc, uint32_t y0, uint32_t y1)
             const hist *hp = c->prev;
             size_t hn = (size_t)hp->w * hp->h;
 #if SY_TEMPORAL_AVX2
-            if (c->avx512 && hn < (size_t)1 << 31)
-                reproject_row_avx512(w, n, hp->world_to_pixel, (int)hp->w, (int)hp->h, hn, hp->illum,
-                                     P->depth_tolerance, P->normal_tolerance, pp + row, pp + n + row,
-                                     pp + 2 * n + row, nx->nrm + row, nx->nrm + n + row, nx->nrm + 2 * n + row,
-                                     plane(c, W_Z) + row, H + row, R + row, RU + row);
-            else if (c->avx2 && hn < (size_t)1 << 31)
+            if (c->avx2 && hn < (size_t)1 << 31)
                 reproject_row_avx2(w, n, hp->world_to_pixel, (int)hp->w, (int)hp->h, hn, hp->illum,
                                    P->depth_tolerance, P->normal_tolerance, pp + row, pp + n + row, pp + 2 * n + row,
                                    nx->nrm + row, nx->nrm + n + row, nx->nrm + 2 * n + row, plane(c, W_Z) + row,
@@ -1252,7 +1161,6 @@ sy_filter_status sy_filter_temporal_run(sy_filter_temporal *t, const sy_filter_f
               .xmax = EXP_MAX, .out = out};
 #if SY_TEMPORAL_AVX2
     c.avx2 = __builtin_cpu_supports("avx2");
-    c.avx512 = c.avx2 && __builtin_cpu_supports("avx512f");
 #endif
     uint32_t th = t->p.threads, rows = in->height;
     double ph[5];
