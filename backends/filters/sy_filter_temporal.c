@@ -900,6 +900,20 @@ static void atrous_end(int w, const float *restrict h, const float *restrict c0,
     }
 }
 
+/* The 8 neighbours of an a-trous pass at step s around column x, each through the caller's SY_TAP
+ * (row u, m or d above, at or below; column; B3-spline weight kd or ke; depth scale for the diagonal) */
+#define SY_ATROUS_TAPS8()                                                                                             \
+    do {                                                                                                              \
+        SY_TAP(u, x - s, kd, dg);                                                                                     \
+        SY_TAP(u, x, ke, 1.0f);                                                                                       \
+        SY_TAP(u, x + s, kd, dg);                                                                                     \
+        SY_TAP(m, x - s, ke, 1.0f);                                                                                   \
+        SY_TAP(m, x + s, ke, 1.0f);                                                                                   \
+        SY_TAP(d, x - s, kd, dg);                                                                                     \
+        SY_TAP(d, x, ke, 1.0f);                                                                                       \
+        SY_TAP(d, x + s, kd, dg);                                                                                     \
+    } while (0)
+
 /* a-trous, the 8 taps of the pixels [x0, x1) of a row at once (every tap column in the image):
  * rows u (y - s), m (y), d (y + s) of class, luminance, depth, normal, colour and variance (a row
  * outside the image: class -1, which no centre matches, and zeros), the centre's normal, luminance
@@ -927,14 +941,7 @@ static void atrous_row8(int x0, int x1, int s, SY_ROW3(float, cl), SY_ROW3(float
         a0 += k * ca##R[j_], a1 += k * cb##R[j_], a2 += k * cc##R[j_];                                                \
         W += k, V += k * k * v##R[j_];                                                                                \
     } while (0)
-        SY_TAP(u, x - s, kd, dg);
-        SY_TAP(u, x, ke, 1.0f);
-        SY_TAP(u, x + s, kd, dg);
-        SY_TAP(m, x - s, ke, 1.0f);
-        SY_TAP(m, x + s, ke, 1.0f);
-        SY_TAP(d, x - s, kd, dg);
-        SY_TAP(d, x, ke, 1.0f);
-        SY_TAP(d, x + s, kd, dg);
+        SY_ATROUS_TAPS8();
 #undef SY_TAP
         float h = (float)(ci > 0.0f), k = 1.0f - h, iw = 1.0f / W;
         float r0 = h * (a0 * iw) + k * cam[x], r1 = h * (a1 * iw) + k * cbm[x], r2 = h * (a2 * iw) + k * ccm[x];
@@ -975,14 +982,7 @@ static void atrous_row8_2(int x0, int x1, int s, SY_ROW3(float, cl), SY_ROW3(flo
         b0 += k2 * ca2##R[j_], b1 += k2 * cb2##R[j_], b2 += k2 * cc2##R[j_];                                          \
         W2 += k2, V2 += k2 * k2 * v2##R[j_];                                                                          \
     } while (0)
-        SY_TAP(u, x - s, kd, dg);
-        SY_TAP(u, x, ke, 1.0f);
-        SY_TAP(u, x + s, kd, dg);
-        SY_TAP(m, x - s, ke, 1.0f);
-        SY_TAP(m, x + s, ke, 1.0f);
-        SY_TAP(d, x - s, kd, dg);
-        SY_TAP(d, x, ke, 1.0f);
-        SY_TAP(d, x + s, kd, dg);
+        SY_ATROUS_TAPS8();
 #undef SY_TAP
         float h = (float)(ci > 0.0f), k = 1.0f - h, iw = 1.0f / W, iw2 = 1.0f / W2;
         float r0 = h * (a0 * iw) + k * cam[x], r1 = h * (a1 * iw) + k * cbm[x], r2 = h * (a2 * iw) + k * ccm[x];

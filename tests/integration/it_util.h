@@ -110,17 +110,29 @@ static inline sy_mesh it_quad_mesh(sy_scene *s, const char *name, const float (*
     return m;
 }
 
-/* An unlit material: the Whitted tracer shows exactly its base colour. */
-static inline sy_material it_unlit(sy_scene *s, const char *name, float r, float g, float b)
+/* A material of base colour (r, g, b): unlit (the Whitted tracer shows exactly its base colour),
+ * or Lambert (roughness 1, not metallic). */
+static inline sy_material it_material_rgb(sy_scene *s, const char *name, float r, float g, float b, bool unlit)
 {
     sy_material m;
     MUST(sy_material_create(s, name, &m, err));
     sy_material_data d = *sy_material_get(s, m);
     d.name = (char *)name;
     d.base_color[0] = r, d.base_color[1] = g, d.base_color[2] = b, d.base_color[3] = 1.0f;
-    d.unlit = 1;
+    if (unlit) d.unlit = 1;
+    else d.metallic = 0.0f, d.roughness = 1.0f;
     MUST(sy_material_set(s, m, &d, err));
     return m;
+}
+
+static inline sy_material it_unlit(sy_scene *s, const char *name, float r, float g, float b)
+{
+    return it_material_rgb(s, name, r, g, b, true);
+}
+
+static inline sy_material it_lambert(sy_scene *s, const char *name, float r, float g, float b)
+{
+    return it_material_rgb(s, name, r, g, b, false);
 }
 
 /* A light of the given type and intensity (the rest at the defaults), on no node yet. */

@@ -29,35 +29,14 @@
  * only where the figure is (the background's pixels are the same bit for bit).
  * Prints the numbers per frame. */
 #include "it_util.h"
+#include "it_temporal.h"
 #include "sy_anim.h"
 #include "sy_mediator_rt.h"
 
-#define W 64
-#define H 48
-#define FRAMES 16
-#define FIRST 6
-#define REF_SPP 256
-
 typedef struct fixture {
-    sy_scene *s;
-    sy_node root, wall, bar, j0, j1, patch, cam_node;
-    sy_viewport *vp;
-    sy_window *win;
-    sy_context_pool *pool[3]; /* 0: per-vertex motion, 1: rigid motion only, 2: reference */
-    sy_layer img[3];
+    it_temporal_rig rig; /* its scene, root, window and the pools: 0 the motion on, 1 off, 2 reference */
+    sy_node wall, bar, j0, j1, patch, cam_node;
 } fixture;
-
-static sy_material lambert(sy_scene *s, const char *name, float r, float g, float b)
-{
-    sy_material m;
-    MUST(sy_material_create(s, name, &m, err));
-    sy_material_data d = *sy_material_get(s, m);
-    d.name = (char *)name;
-    d.base_color[0] = r, d.base_color[1] = g, d.base_color[2] = b, d.base_color[3] = 1.0f;
-    d.metallic = 0.0f, d.roughness = 1.0f;
-    MUST(sy_material_set(s, m, &d, err));
-    return m;
-}
 
 /* A tube of radius r along x over [x0, x1] about the axis (y = 0, z = 0) + (0, yc, zc), nx x na
  * cells, in stripes of `stripe` along x: two primitives (red and green cells, each cell with its own
@@ -125,35 +104,19 @@ static void rot_z(sy_scene *s, sy_node n, float x, float y, float z, float a)
 static void pose(fixture *fx, int f)
 {
     float ph = sinf(0.4f * (float)f);
-    rot_z(fx->s, fx->j0, -1.0f, 0.45f + 0.3f * ph, 0.6f, -0.15f * ph);
-    rot_z(fx->s, fx->j1, 1.0f, 0.0f, 0.0f, 0.5f * ph);
+    rot_z(fx->rig.s, fx->j0, -1.0f, 0.45f + 0.3f * ph, 0.6f, -0.15f * ph);
+    rot_z(fx->rig.s, fx->j1, 1.0f, 0.0f, 0.0f, 0.5f * ph);
     float w = 0.9f * ph;
-    MUST(sy_node_set_weights(fx->s, fx->patch, &w, 1, err));
-    rot_z(fx->s, fx->patch, -0.45f + 0.02f * (float)f, -0.35f, 0.0f, 0.1f);
-}
-
-static sy_context *ctx_of(fixture *fx, int k)
-{
-    sy_context *ctx;
-    MUST(sy_context_pool_get(fx->pool[k], fx->s, "pathtracer", NULL, fx->root.id, &ctx, err));
-    return ctx;
+    MUST(sy_node_set_weights(fx->rig.s, fx->patch, &w, 1, err));
+    rot_z(fx->rig.s, fx->patch, -0.45f + 0.02f * (float)f, -0.35f, 0.0f, 0.1f);
 }
 
 static void build(fixture *fx)
 {
     memset(fx, 0, sizeof *fx);
-    MUST(sy_scene_create(&fx->s, err));
-    sy_scene *s = fx->s;
-    MUST(sy_node_create(s, "root", &fx->root, err));
-    sy_material grey[2] = {lambert(s, "light grey", 0.8f, 0.8f, 0.8f), lambert(s, "dark grey", 0.3f, 0.3f, 0.3f)};
-    sy_material rg[2] = {lambert(s, "red", 0.9f, 0.15f, 0.1f), lambert(s, "green", 0.1f, 0.8f, 0.2f)};
-    float wq[8][3];
-    sy_material wm[8];
-    for (int i = 0; i < 8; ++i) { /* a 4 x 2 checkerboard of unit squares */
-        wq[i][0] = -1.5f + (float)(i % 4), wq[i][1] = i < 4 ? -0.5f : 0.5f, wq[i][2] = 0.5f;
-        wm[i] = grey[(i + i / 4) % 2];
-    }
-    sy_mesh wall = it_quad_mesh(s, "wall", (const float(*)[3])wq, wm, 8);
+    sy_material grey[2], rg[2];
+    sy_mesh wall = it_rig_scene(&fx->rig, grey, rg);
+    sy_scene *s = fx->rig.s;
     /* the bar in its bind pose (world space, as glTF skins): x -1 .. 1 about y 0.45, z 0.6 */
     sy_mesh bar = tube(s, "bar", -1.0f, 1.0f, 0.45f, 0.6f, 0.18f, 32, 16, 0.5f, rg, true, false);
     /* the patch about its node: x -0.6 .. 0.6 about y 0, z 0.2 (in front of the wall, behind the bar) */
@@ -177,49 +140,9 @@ static void build(fixture *fx)
     pose(fx, 0);
     fx->cam_node = it_camera_node(s, "cam", 0, 0, 2.5f, 0.8f);
     sy_node kids[5] = {fx->wall, fx->j0, fx->bar, fx->patch, fx->cam_node};
-    for (int i = 0; i < 5; ++i) MUST(sy_node_add_child(s, fx->root, kids[i], err));
+    for (int i = 0; i < 5; ++i) MUST(sy_node_add_child(s, fx->rig.root, kids[i], err));
     MUST(sy_scene_commit(s, NULL, err));
-    sy_viewport_desc vd = {.root = fx->root, .camera = fx->cam_node, .backend = "pathtracer"};
-    fx->win = it_window(W, H, &vd, &fx->vp);
-    for (int k = 0; k < 3; ++k) {
-        MUST(sy_context_pool_create(&fx->pool[k], err));
-        MUST(sy_layer_create(W, H, &fx->img[k], err));
-    }
-    const char *deform[2] = {"1", "0"};
-    for (int k = 0; k < 2; ++k) {
-        sy_params p = {0};
-        MUST(sy_params_set(&p, "temporal", "1", err));
-        MUST(sy_params_set(&p, "temporal_deform", deform[k], err));
-        MUST(sy_context_set_filter(ctx_of(fx, k), "none", &p, err));
-    }
-}
-
-static void destroy(fixture *fx)
-{
-    for (int k = 0; k < 3; ++k) {
-        sy_layer_destroy(&fx->img[k]);
-        sy_context_pool_destroy(fx->pool[k]);
-    }
-    sy_window_destroy(fx->win);
-    sy_scene_destroy(fx->s);
-}
-
-static void render(fixture *fx, int k, uint32_t spp)
-{
-    sy_window_render_opts ro = {.sample_count = spp, .seed = 5};
-    MUST(sy_window_render(fx->win, fx->s, fx->pool[k], &ro, &fx->img[k], err));
-}
-
-/* relMSE of a against ref over the pixels of class c (mask[i] == c), summed into sum[c] / cnt[c]. */
-static void rel_mse(const sy_layer *a, const sy_layer *ref, const uint8_t *mask, double sum[3], double cnt[3])
-{
-    for (size_t i = 0; i < (size_t)W * H; ++i)
-        for (int c = 0; c < 3; ++c) {
-            double r = ref->rgba[4 * i + c], d = a->rgba[4 * i + c] - r;
-            if (mask[i] > 2) continue;
-            sum[mask[i]] += d * d / (r * r + 0.01);
-            cnt[mask[i]] += 1.0;
-        }
+    it_rig_init(&fx->rig, W, H, fx->cam_node, "temporal_deform");
 }
 
 static const char *const class_name[3] = {"wall", "skinned bar", "morphing patch"};
@@ -295,12 +218,12 @@ int main(void)
     double sum[2][3] = {{0}}, cnt[2][3] = {{0}}; /* [per-vertex on/off][wall/bar/patch] */
     for (int f = 0; f < FRAMES; ++f) {
         pose(&fx, f);
-        MUST(sy_scene_commit(fx.s, NULL, err));
+        MUST(sy_scene_commit(fx.rig.s, NULL, err));
         for (int k = 0; k < 2; ++k) {
-            render(&fx, k, 1);
-            EXPECT(sy_layer_count_nonfinite(&fx.img[k]) == 0);
+            it_rig_render(&fx.rig, k, 1);
+            EXPECT(sy_layer_count_nonfinite(&fx.rig.img[k]) == 0);
             sy_mediator_rt_filter_info fi;
-            sy_mediator_rt_filter_info_get(sy_context_state(ctx_of(&fx, k)), &fi);
+            sy_mediator_rt_filter_info_get(sy_context_state(it_rig_ctx(&fx.rig, k)), &fi);
             if (f > 0 && k == 0)
                 EXPECT_MSG(fi.temporal_last && fi.temporal_deformed_pixels > 100,
                            "frame %d: estimate %d, %llu pixels with per-vertex motion", f, fi.temporal_last,
@@ -311,9 +234,9 @@ int main(void)
                            fi.temporal_last, (unsigned long long)fi.temporal_deformed_pixels,
                            (unsigned long long)fi.temporal_moving_pixels);
         }
-        render(&fx, 2, REF_SPP);
+        it_rig_render(&fx.rig, 2, REF_SPP);
         sy_aovs a;
-        MUST(sy_context_aovs(ctx_of(&fx, 2), &a, err));
+        MUST(sy_context_aovs(it_rig_ctx(&fx.rig, 2), &a, err));
         const float *ids = NULL;
         for (uint32_t p = 0; p < a.count; ++p)
             if (!strcmp(a.planes[p].name, "object_id")) ids = a.planes[p].data;
@@ -343,7 +266,7 @@ int main(void)
         if (f < FIRST) continue;
         double fs[2][3] = {{0}}, fc[2][3] = {{0}};
         for (int k = 0; k < 2; ++k) {
-            rel_mse(&fx.img[k], &fx.img[2], mask, fs[k], fc[k]);
+            it_rel_mse_classes(&fx.rig.img[k], &fx.rig.img[2], mask, 3, fs[k], fc[k]);
             for (int j = 0; j < 3; ++j) sum[k][j] += fs[k][j], cnt[k][j] += fc[k][j];
         }
         printf("frame %2d: relMSE bar %.4f per-vertex, %.4f rigid only; patch %.4f, %.4f; wall %.4f, %.4f (%zu, %zu, %zu px)\n",
@@ -362,10 +285,10 @@ int main(void)
     for (int f = 0; f < 3; ++f) {
         sy_mat4 m = sy_mat4_identity();
         m.m[12] = 0.03f * (float)(f + 1), m.m[14] = 2.5f;
-        sy_viewport_set_view(fx.vp, &m);
-        render(&fx, 0, 1);
+        sy_viewport_set_view(fx.rig.vp, &m);
+        it_rig_render(&fx.rig, 0, 1);
         sy_mediator_rt_filter_info fi;
-        sy_mediator_rt_filter_info_get(sy_context_state(ctx_of(&fx, 0)), &fi);
+        sy_mediator_rt_filter_info_get(sy_context_state(it_rig_ctx(&fx.rig, 0)), &fi);
         EXPECT_MSG(fi.temporal_last && fi.temporal_deformed_pixels == 0 && fi.temporal_moving_pixels == 0,
                    "pan %d after the meshes stopped: estimate %d, %llu deformed, %llu moving pixels", f, fi.temporal_last,
                    (unsigned long long)fi.temporal_deformed_pixels, (unsigned long long)fi.temporal_moving_pixels);
@@ -374,17 +297,17 @@ int main(void)
     for (int step = 0; step < 2; ++step) {
         sy_params p = {0};
         MUST(sy_params_set(&p, "temporal_deform", step ? "1" : "0", err));
-        MUST(sy_context_set_filter(ctx_of(&fx, 0), NULL, &p, err));
+        MUST(sy_context_set_filter(it_rig_ctx(&fx.rig, 0), NULL, &p, err));
         pose(&fx, FRAMES + step);
-        MUST(sy_scene_commit(fx.s, NULL, err));
-        render(&fx, 0, 1);
+        MUST(sy_scene_commit(fx.rig.s, NULL, err));
+        it_rig_render(&fx.rig, 0, 1);
         sy_mediator_rt_filter_info fi;
-        sy_mediator_rt_filter_info_get(sy_context_state(ctx_of(&fx, 0)), &fi);
+        sy_mediator_rt_filter_info_get(sy_context_state(it_rig_ctx(&fx.rig, 0)), &fi);
         EXPECT_MSG(fi.temporal_last && (fi.temporal_deformed_pixels > 0) == (step == 1),
                    "temporal_deform=%d live: estimate %d, %llu deformed pixels", step, fi.temporal_last,
                    (unsigned long long)fi.temporal_deformed_pixels);
     }
-    destroy(&fx);
+    it_rig_destroy(&fx.rig);
     loaded_skin();
     return sy_check_finish("integration_pathtracer_deform");
 }

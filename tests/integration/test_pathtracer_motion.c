@@ -24,35 +24,14 @@
  * that is a moving frame again.
  * Prints the numbers per frame. */
 #include "it_util.h"
+#include "it_temporal.h"
 #include "sy_mediator_rt.h"
 
-#define W 64
-#define H 48
-#define FRAMES 16
-#define FIRST 6
-#define REF_SPP 256
-
 typedef struct fixture {
-    sy_scene *s;
-    sy_node root, wall, ball, cam_node;
+    it_temporal_rig rig; /* its scene, root, window and the pools: 0 the motion on, 1 off, 2 reference */
+    sy_node wall, ball, cam_node;
     sy_material light_grey;
-    sy_viewport *vp;
-    sy_window *win;
-    sy_context_pool *pool[3]; /* 0: motion, 1: camera only, 2: reference */
-    sy_layer img[3];
 } fixture;
-
-static sy_material lambert(sy_scene *s, const char *name, float r, float g, float b)
-{
-    sy_material m;
-    MUST(sy_material_create(s, name, &m, err));
-    sy_material_data d = *sy_material_get(s, m);
-    d.name = (char *)name;
-    d.base_color[0] = r, d.base_color[1] = g, d.base_color[2] = b, d.base_color[3] = 1.0f;
-    d.metallic = 0.0f, d.roughness = 1.0f;
-    MUST(sy_material_set(s, m, &d, err));
-    return m;
-}
 
 /* A sphere of radius 0.35 about the origin (24 x 16 segments, smooth normals) in six meridian
  * stripes, red and green by turns: one primitive per stripe. */
@@ -95,32 +74,16 @@ static void place_ball(fixture *fx, int f)
     float a = 0.3f;
     const float t[3] = {-0.6f + 0.08f * (float)f, 0.0f, 0.4f + 0.04f * (float)f}, q[4] = {0, sinf(0.5f * a), 0, cosf(0.5f * a)},
                 one[3] = {1, 1, 1};
-    MUST(sy_node_set_trs(fx->s, fx->ball, t, q, one, err));
-}
-
-static sy_context *ctx_of(fixture *fx, int k)
-{
-    sy_context *ctx;
-    MUST(sy_context_pool_get(fx->pool[k], fx->s, "pathtracer", NULL, fx->root.id, &ctx, err));
-    return ctx;
+    MUST(sy_node_set_trs(fx->rig.s, fx->ball, t, q, one, err));
 }
 
 static void build(fixture *fx)
 {
     memset(fx, 0, sizeof *fx);
-    MUST(sy_scene_create(&fx->s, err));
-    sy_scene *s = fx->s;
-    MUST(sy_node_create(s, "root", &fx->root, err));
-    sy_material grey[2] = {lambert(s, "light grey", 0.8f, 0.8f, 0.8f), lambert(s, "dark grey", 0.3f, 0.3f, 0.3f)};
+    sy_material grey[2], rg[2];
+    sy_mesh wall = it_rig_scene(&fx->rig, grey, rg);
+    sy_scene *s = fx->rig.s;
     fx->light_grey = grey[0];
-    sy_material rg[2] = {lambert(s, "red", 0.9f, 0.15f, 0.1f), lambert(s, "green", 0.1f, 0.8f, 0.2f)};
-    float wq[8][3];
-    sy_material wm[8];
-    for (int i = 0; i < 8; ++i) { /* a 4 x 2 checkerboard of unit squares */
-        wq[i][0] = -1.5f + (float)(i % 4), wq[i][1] = i < 4 ? -0.5f : 0.5f, wq[i][2] = 0.5f;
-        wm[i] = grey[(i + i / 4) % 2];
-    }
-    sy_mesh wall = it_quad_mesh(s, "wall", (const float(*)[3])wq, wm, 8);
     sy_mesh ball = sphere(s, rg);
     MUST(sy_node_create(s, "wall", &fx->wall, err));
     MUST(sy_node_set_mesh(s, fx->wall, wall, err));
@@ -129,50 +92,9 @@ static void build(fixture *fx)
     place_ball(fx, 0);
     fx->cam_node = it_camera_node(s, "cam", 0, 0, 2.5f, 0.8f);
     sy_node kids[3] = {fx->wall, fx->ball, fx->cam_node};
-    for (int i = 0; i < 3; ++i) MUST(sy_node_add_child(s, fx->root, kids[i], err));
+    for (int i = 0; i < 3; ++i) MUST(sy_node_add_child(s, fx->rig.root, kids[i], err));
     MUST(sy_scene_commit(s, NULL, err));
-    sy_viewport_desc vd = {.root = fx->root, .camera = fx->cam_node, .backend = "pathtracer"};
-    fx->win = it_window(W, H, &vd, &fx->vp);
-    for (int k = 0; k < 3; ++k) {
-        MUST(sy_context_pool_create(&fx->pool[k], err));
-        MUST(sy_layer_create(W, H, &fx->img[k], err));
-    }
-    const char *motion[2] = {"1", "0"};
-    for (int k = 0; k < 2; ++k) {
-        sy_params p = {0};
-        MUST(sy_params_set(&p, "temporal", "1", err));
-        MUST(sy_params_set(&p, "temporal_motion", motion[k], err));
-        MUST(sy_context_set_filter(ctx_of(fx, k), "none", &p, err));
-    }
-}
-
-static void destroy(fixture *fx)
-{
-    for (int k = 0; k < 3; ++k) {
-        sy_layer_destroy(&fx->img[k]);
-        sy_context_pool_destroy(fx->pool[k]);
-    }
-    sy_window_destroy(fx->win);
-    sy_scene_destroy(fx->s);
-}
-
-static void render(fixture *fx, int k, uint32_t spp)
-{
-    sy_window_render_opts ro = {.sample_count = spp, .seed = 5};
-    MUST(sy_window_render(fx->win, fx->s, fx->pool[k], &ro, &fx->img[k], err));
-}
-
-/* relMSE of a against ref over the pixels whose mask equals want (1: the ball, 0: the wall), summed
- * into sum[] / cnt[]. */
-static void rel_mse(const sy_layer *a, const sy_layer *ref, const uint8_t *mask, double sum[2], double cnt[2])
-{
-    for (size_t i = 0; i < (size_t)W * H; ++i)
-        for (int c = 0; c < 3; ++c) {
-            double r = ref->rgba[4 * i + c], d = a->rgba[4 * i + c] - r;
-            if (mask[i] > 1) continue;
-            sum[mask[i]] += d * d / (r * r + 0.01);
-            cnt[mask[i]] += 1.0;
-        }
+    it_rig_init(&fx->rig, W, H, fx->cam_node, "temporal_motion");
 }
 
 /* One sequence: the ball slides; pan: the camera too. */
@@ -182,15 +104,15 @@ static void sequence(fixture *fx, bool pan)
     double sum[2][2] = {{0}}, cnt[2][2] = {{0}}; /* [motion on/off][wall/ball] */
     for (int f = 0; f < FRAMES; ++f) {
         place_ball(fx, f);
-        MUST(sy_scene_commit(fx->s, NULL, err));
+        MUST(sy_scene_commit(fx->rig.s, NULL, err));
         sy_mat4 m = sy_mat4_identity();
         m.m[12] = pan ? -0.2f + 0.03f * (float)f : 0.0f, m.m[14] = 2.5f;
-        sy_viewport_set_view(fx->vp, &m);
+        sy_viewport_set_view(fx->rig.vp, &m);
         for (int k = 0; k < 2; ++k) {
-            render(fx, k, 1);
-            EXPECT(sy_layer_count_nonfinite(&fx->img[k]) == 0);
+            it_rig_render(&fx->rig, k, 1);
+            EXPECT(sy_layer_count_nonfinite(&fx->rig.img[k]) == 0);
             sy_mediator_rt_filter_info fi;
-            sy_mediator_rt_filter_info_get(sy_context_state(ctx_of(fx, k)), &fi);
+            sy_mediator_rt_filter_info_get(sy_context_state(it_rig_ctx(&fx->rig, k)), &fi);
             if (f > 0 && k == 0)
                 EXPECT_MSG(fi.temporal_last && fi.temporal_moving_pixels > 0, "%s frame %d: estimate %d, moving pixels %llu",
                            name, f, fi.temporal_last, (unsigned long long)fi.temporal_moving_pixels);
@@ -198,9 +120,9 @@ static void sequence(fixture *fx, bool pan)
                 EXPECT_MSG(fi.temporal_last == pan && fi.temporal_moving_pixels == 0,
                            "%s frame %d without object motion: estimate %d", name, f, fi.temporal_last);
         }
-        render(fx, 2, REF_SPP);
+        it_rig_render(&fx->rig, 2, REF_SPP);
         sy_aovs a;
-        MUST(sy_context_aovs(ctx_of(fx, 2), &a, err));
+        MUST(sy_context_aovs(it_rig_ctx(&fx->rig, 2), &a, err));
         const float *ids = NULL;
         for (uint32_t p = 0; p < a.count; ++p)
             if (!strcmp(a.planes[p].name, "object_id")) ids = a.planes[p].data;
@@ -226,7 +148,7 @@ static void sequence(fixture *fx, bool pan)
         if (f < FIRST) continue;
         double fs[2][2] = {{0}}, fc[2][2] = {{0}};
         for (int k = 0; k < 2; ++k) {
-            rel_mse(&fx->img[k], &fx->img[2], mask, fs[k], fc[k]);
+            it_rel_mse_classes(&fx->rig.img[k], &fx->rig.img[2], mask, 2, fs[k], fc[k]);
             for (int j = 0; j < 2; ++j) sum[k][j] += fs[k][j], cnt[k][j] += fc[k][j];
         }
         printf("%s frame %2d: ball relMSE %.4f with object motion, %.4f camera only; wall %.4f, %.4f\n", name, f,
@@ -251,12 +173,12 @@ int main(void)
     sequence(&fx, true);
     /* the camera and the ball rest: blended with the estimate at first, then the accumulation bit
      * for bit (from 64 samples on) */
-    sy_context *ctx = ctx_of(&fx, 0);
+    sy_context *ctx = it_rig_ctx(&fx.rig, 0);
     for (uint32_t k = 2; k <= 65; ++k) {
-        render(&fx, 0, 1);
+        it_rig_render(&fx.rig, 0, 1);
         sy_mediator_rt_aovs a;
         MUST(sy_mediator_rt_aovs_get(sy_context_state(ctx), &a, err));
-        bool same = !memcmp(a.planes[0], fx.img[0].rgba, (size_t)W * H * 4 * sizeof(float));
+        bool same = !memcmp(a.planes[0], fx.rig.img[0].rgba, (size_t)W * H * 4 * sizeof(float));
         EXPECT_MSG(a.samples == k, "still frame %u: %u samples", k, a.samples);
         sy_mediator_rt_aovs_free(&a);
         sy_mediator_rt_filter_info fi;
@@ -266,17 +188,17 @@ int main(void)
     }
     /* a change that is not a move (a material) under the still camera: the accumulation restarts and
      * shows alone, as before; a move after it is a moving frame again */
-    sy_material_data md = *sy_material_get(fx.s, fx.light_grey);
+    sy_material_data md = *sy_material_get(fx.rig.s, fx.light_grey);
     md.name = "light grey";
     md.base_color[0] = 0.7f;
-    MUST(sy_material_set(fx.s, fx.light_grey, &md, err));
+    MUST(sy_material_set(fx.rig.s, fx.light_grey, &md, err));
     for (int step = 0; step < 2; ++step) {
         if (step) place_ball(&fx, 3);
-        MUST(sy_scene_commit(fx.s, NULL, err));
-        render(&fx, 0, 1);
+        MUST(sy_scene_commit(fx.rig.s, NULL, err));
+        it_rig_render(&fx.rig, 0, 1);
         sy_mediator_rt_aovs a;
         MUST(sy_mediator_rt_aovs_get(sy_context_state(ctx), &a, err));
-        bool same = !memcmp(a.planes[0], fx.img[0].rgba, (size_t)W * H * 4 * sizeof(float));
+        bool same = !memcmp(a.planes[0], fx.rig.img[0].rgba, (size_t)W * H * 4 * sizeof(float));
         EXPECT_MSG(a.samples == 1, "after the %s: %u samples", step ? "move" : "material change", a.samples);
         sy_mediator_rt_aovs_free(&a);
         sy_mediator_rt_filter_info fi;
@@ -285,6 +207,6 @@ int main(void)
                    "after the %s: estimate %d, the accumulation %d", step ? "move" : "material change", fi.temporal_last,
                    same);
     }
-    destroy(&fx);
+    it_rig_destroy(&fx.rig);
     return sy_check_finish("integration_pathtracer_motion");
 }
