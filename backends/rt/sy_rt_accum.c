@@ -113,32 +113,6 @@ const char *sy_rt_aov_name(sy_rt_aov aov)
     return (unsigned)aov < SY_RT_AOV_COUNT ? names[aov] : NULL;
 }
 
-sy_rt_result sy_rt_accum_read(sy_rt_device *dev, const sy_rt_accum *a, sy_rt_aov aov, float *out)
-{
-    if (!a || !out) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "accum read: NULL argument");
-    uint32_t ch = sy_rt_aov_channels(aov);
-    if (!ch) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "accum read: unknown AOV %d", (int)aov);
-    size_t n = (size_t)a->width * a->height;
-    float nn = (float)a->samples;
-    for (size_t i = 0; i < n; ++i) {
-        const float *r = a->data + i * SY_RT_ACC_STRIDE;
-        float *o = out + i * ch;
-        switch (aov) {
-        case SY_RT_AOV_COLOR: memcpy(o, r + SY_RT_ACC_COLOR, 4 * sizeof(float)); break;
-        case SY_RT_AOV_VARIANCE:
-            for (int k = 0; k < 3; ++k) o[k] = a->samples > 1 ? r[SY_RT_ACC_M2 + k] / ((nn - 1.0f) * nn) : 0.0f;
-            break;
-        case SY_RT_AOV_ALBEDO: memcpy(o, r + SY_RT_ACC_ALBEDO, 3 * sizeof(float)); break;
-        case SY_RT_AOV_NORMAL: memcpy(o, r + SY_RT_ACC_NORMAL, 3 * sizeof(float)); break;
-        case SY_RT_AOV_DIRECT: memcpy(o, r + SY_RT_ACC_DIRECT, 3 * sizeof(float)); break;
-        case SY_RT_AOV_INDIRECT: memcpy(o, r + SY_RT_ACC_INDIRECT, 3 * sizeof(float)); break;
-        case SY_RT_AOV_DEPTH: o[0] = r[SY_RT_ACC_HITS] > 0.0f ? r[SY_RT_ACC_DEPTH] : INFINITY; break;
-        default: break;
-        }
-    }
-    return SY_RT_OK;
-}
-
 sy_rt_result sy_rt_accum_read_rows(sy_rt_device *dev, const sy_rt_accum *a, uint32_t y0, uint32_t y1,
                                    float *const out[SY_RT_AOV_COUNT])
 {
@@ -162,4 +136,13 @@ sy_rt_result sy_rt_accum_read_rows(sy_rt_device *dev, const sy_rt_accum *a, uint
         if (ind) memcpy(ind + 3 * i, r + SY_RT_ACC_INDIRECT, 3 * sizeof(float));
     }
     return SY_RT_OK;
+}
+
+sy_rt_result sy_rt_accum_read(sy_rt_device *dev, const sy_rt_accum *a, sy_rt_aov aov, float *out)
+{
+    if (!a || !out) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "accum read: NULL argument");
+    if (!sy_rt_aov_channels(aov)) return FAIL(SY_RT_ERROR_INVALID_ARGUMENT, "accum read: unknown AOV %d", (int)aov);
+    float *outs[SY_RT_AOV_COUNT] = {0};
+    outs[aov] = out;
+    return sy_rt_accum_read_rows(dev, a, 0, a->height, outs); /* one plane of the one conversion */
 }
