@@ -485,7 +485,7 @@ typedef struct motion_run { /* what the pixels of one instance share (looked up 
     const rt_move_rec *mr;     /* moved since the last render, or NULL */
     const rt_deform_rec *dr;   /* its mesh deformed since the last render, or NULL */
     sy_rt_mesh_view now;       /* dr: the mesh's present vertices */
-    float xf[16], prev[16];    /* dr: its matrix now and at the last render */
+    sy_mat4 xf, prev;          /* dr: its matrix now and at the last render */
 } motion_run;
 
 static void motion_run_get(rt_state *st, uint32_t id, bool deform, motion_run *run)
@@ -493,14 +493,13 @@ static void motion_run_get(rt_state *st, uint32_t id, bool deform, motion_run *r
     run->dr = NULL;
     rt_move_rec *r = id ? sy_mirror_map_get(&st->temporal_from, id) : NULL;
     if (r && !r->ready) { /* to_prev = prev now^-1, NaN when now has no inverse */
-        sy_mat4 now, inv, prev, tp;
+        sy_mat4 now, inv, prev;
         r->ready = true;
         if (sy_rt_instance_get_transform(st->dev, (sy_rt_instance){id}, now.m) == SY_RT_OK && sy_mat4_invert(&now, &inv)) {
             memcpy(prev.m, r->prev, sizeof prev.m);
-            tp = sy_mat4_mul(&prev, &inv);
-            memcpy(r->to_prev, tp.m, sizeof tp.m);
+            r->to_prev = sy_mat4_mul(&prev, &inv);
         } else {
-            for (int k = 0; k < 16; ++k) r->to_prev[k] = NAN;
+            for (int k = 0; k < 16; ++k) r->to_prev.m[k] = NAN;
         }
     }
     run->mr = r;
@@ -509,20 +508,20 @@ static void motion_run_get(rt_state *st, uint32_t id, bool deform, motion_run *r
     const rt_deform_rec *d = sy_mirror_map_get(&st->temporal_deform, mesh.id);
     if (!d || !d->fresh || sy_rt_mesh_get_view(st->dev, mesh, &run->now) != SY_RT_OK ||
         run->now.vertex_count != d->vertex_count ||
-        sy_rt_instance_get_transform(st->dev, (sy_rt_instance){id}, run->xf) != SY_RT_OK)
+        sy_rt_instance_get_transform(st->dev, (sy_rt_instance){id}, run->xf.m) != SY_RT_OK)
         return;
-    if (r) memcpy(run->prev, r->prev, sizeof run->prev);
-    else memcpy(run->prev, run->xf, sizeof run->prev);
+    if (r) memcpy(run->prev.m, r->prev, sizeof run->prev.m);
+    else run->prev = run->xf;
     run->dr = d;
 }
 
 /* x = M (b0 p[i0] + u p[i1] + v p[i2]) */
-static inline void bary_point(const float *m, const float *p, const uint32_t *ix, float u, float v, float x[3])
+static inline void bary_point(const sy_mat4 *m, const float *p, const uint32_t *ix, float u, float v, float x[3])
 {
     float b0 = 1.0f - u - v, o[3];
     const float *a = p + 3u * ix[0], *b = p + 3u * ix[1], *c = p + 3u * ix[2];
     for (int k = 0; k < 3; ++k) o[k] = b0 * a[k] + u * b[k] + v * c[k];
-    for (int k = 0; k < 3; ++k) x[k] = m[k] * o[0] + m[4 + k] * o[1] + m[8 + k] * o[2] + m[12 + k];
+    sy_mat4_transform_point(m, o, x);
 }
 
 static sy_result object_motion(rt_state *st, const sy_render_request *req, const float *pos, bool *any,
@@ -574,8 +573,8 @@ static sy_result object_motion(rt_state *st, const sy_render_request *req, const
             if (h->triangle < run.now.triangle_count) {
                 const uint32_t *ix = run.now.indices + 3u * h->triangle;
                 float a[3], b[3];
-                bary_point(run.prev, run.dr->prev, ix, h->u, h->v, a);
-                bary_point(run.xf, run.now.positions, ix, h->u, h->v, b);
+                bary_point(&run.prev, run.dr->prev, ix, h->u, h->v, a);
+                bary_point(&run.xf, run.now.positions, ix, h->u, h->v, b);
                 for (int k = 0; k < 3; ++k) o[k] = a[k] - b[k];
             } else {
                 o[0] = o[1] = o[2] = 0.0f;
@@ -587,8 +586,9 @@ static sy_result object_motion(rt_state *st, const sy_render_request *req, const
             o[0] = o[1] = o[2] = 0.0f;
             continue;
         }
-        const float *p = pos + 3 * i, *m = run.mr->to_prev;
-        for (int k = 0; k < 3; ++k) o[k] = m[k] * p[0] + m[4 + k] * p[1] + m[8 + k] * p[2] + m[12 + k] - p[k];
+        const float *p = pos + 3 * i;
+        sy_mat4_transform_point(&run.mr->to_prev, p, o);
+        for (int k = 0; k < 3; ++k) o[k] -= p[k];
         if (o[0] != 0.0f || o[1] != 0.0f || o[2] != 0.0f) ++*pixels;
     }
     *any = true;

@@ -80,7 +80,7 @@ typedef struct pt_filter_cfg {
  * matrix then, and (ready) prev x now^-1, the map of this render's points to their earlier places. */
 typedef struct rt_move_rec {
     float prev[16];
-    float to_prev[16];
+    sy_mat4 to_prev;
     bool ready;
 } rt_move_rec;
 
