@@ -1,7 +1,8 @@
 /* raw_peer.h — plain-socket cluster peers for the tests: connect to a 127.0.0.1 port, write
  * frames or arbitrary bytes, read (and reassemble) the server's frames of an untagged session.
  * Header-only (static functions); every call is bounded by the socket timeouts set at connect.
- * Used by test_cluster_net.c (messages a client library would never send) and
+ * Used by test_cluster_net.c (messages a client library would never send), test_cluster_coop.c
+ * (a fake server that misbehaves under pipelining) and
  * test_cluster_hostile.c (hostile connections). Thread-safety: one fd per thread. */
 #ifndef SY_TEST_RAW_PEER_H
 #define SY_TEST_RAW_PEER_H
