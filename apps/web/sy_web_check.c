@@ -337,6 +337,13 @@ void sy_web_check_request(const sy_web_policy *p, const sy_web_head *h, sy_web_v
         v->target = SY_WEB_TARGET_ASSET;
         return;
     }
+    if (!strcmp(path, "/api/latest.jpg")) { /* costs a copy of bytes already made, but shows the view */
+        if (!same_origin_or_token(h, v, token_required))
+            return refused(v, 403, h->origin ? "the latest frame for the foreign origin %.100s" : "the latest frame without Origin%s",
+                           h->origin ? h->origin : " (and no token)");
+        v->target = SY_WEB_TARGET_LATEST;
+        return;
+    }
     if (!strcmp(path, "/api/frame.jpg")) {
         if (!same_origin_or_token(h, v, token_required))
             return refused(v, 403, h->origin ? "a still for the foreign origin %.100s" : "a still without Origin%s",

@@ -75,6 +75,7 @@ typedef enum sy_web_target {
     SY_WEB_TARGET_REFUSED, /**< answered with verdict.status */
     SY_WEB_TARGET_ASSET,   /**< GET of the page or one of its files (verdict.asset) */
     SY_WEB_TARGET_STILL,   /**< GET /api/frame.jpg (size in the verdict) */
+    SY_WEB_TARGET_LATEST,  /**< GET /api/latest.jpg: the newest streamed frame, no rendering */
     SY_WEB_TARGET_STREAM,  /**< the WebSocket upgrade at /ws */
     SY_WEB_TARGET_ROUTE    /**< a route of the embedding program (verdict.route) */
 } sy_web_target;

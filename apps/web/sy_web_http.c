@@ -5,6 +5,7 @@
 
 #include "sy_log.h"
 #include "sy_web_assets.h"
+#include "sy_web_frame.h"
 
 #include <ctype.h>
 #include <stdarg.h>
@@ -167,6 +168,20 @@ static int still_request(sy_web *w, struct lws *wsi, http_pss *p, uint32_t sw, u
     return 0;
 }
 
+/* The newest frame the viewers were sent, as its JPEG (the page's first picture while its
+ * WebSocket opens: docs/WEB.md, "The first picture"); 204 (no content, not an error: the page
+ * waits for its socket's frames) before the first frame or while only video viewers are sent
+ * frames (no JPEG made). A copy of bytes already made: no rendering. */
+static int latest_request(sy_web *w, struct lws *wsi, http_pss *p)
+{
+    pthread_mutex_lock(&w->mu);
+    web_frame *f = w->latest;
+    int r = f && f->jpeg_len ? respond(wsi, p, 200, "image/jpeg", f->buf + LWS_PRE + SY_WEB_FRAME_HEADER, f->jpeg_len)
+                             : respond(wsi, p, 204, "image/jpeg", NULL, 0);
+    pthread_mutex_unlock(&w->mu);
+    return r;
+}
+
 static int http_request(sy_web *w, struct lws *wsi, http_pss *p, const char *uri)
 {
     memset(p, 0, sizeof *p);
@@ -200,6 +215,7 @@ static int http_request(sy_web *w, struct lws *wsi, http_pss *p, const char *uri
         lws_callback_on_writable(wsi);
         return 0;
     case SY_WEB_TARGET_STILL: return still_request(w, wsi, p, v.still_w, v.still_h);
+    case SY_WEB_TARGET_LATEST: return latest_request(w, wsi, p);
     case SY_WEB_TARGET_ROUTE:
         if (post) {
             p->route = v.route; /* the body follows: HTTP_BODY, then HTTP_BODY_COMPLETION */

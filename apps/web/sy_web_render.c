@@ -246,6 +246,85 @@ static void set_status(sy_web *w, const char *s)
     sy_webi_wake_network(w);
 }
 
+/* A frame cls rendered from orbit at fw x fh (px and depth taken, freed here) made into the newest
+ * frame: JPEG (while a viewer takes it, or none said yet), the pixels for video viewers, the
+ * camera the page warps it with, the depth channel (the view's coded one again for a
+ * refinement), packed and published. gen: the input generation it answers; *ms: from t0 (the
+ * render's start) to packed. */
+static sy_result publish_rendered(sy_web *w, render_state *rs, const sy_mediator_class *cls, uint32_t bi,
+                                  const sy_orbit *orbit, uint32_t fw, uint32_t fh, uint8_t *px, float *depth,
+                                  uint64_t gen, double t0, double *ms, sy_error *err)
+{
+    uint8_t *jpeg = NULL;
+    size_t jlen = 0;
+    /* video viewers get the pixels (each one's encoder runs as its frame is sent); JPEG is made
+     * only while a viewer takes it (or none said yet) */
+    pthread_mutex_lock(&w->mu);
+    bool keep_px = w->video_viewers > 0, want_jpeg = w->jpeg_viewers > 0 || !w->video_viewers;
+    pthread_mutex_unlock(&w->mu);
+    sy_result r = SY_OK;
+    if (want_jpeg) r = sy_jpeg_encode_rgba8(px, fw, fh, w->d.quality, &jpeg, &jlen, err);
+    /* the render thread keeps the newest pixels (republish_with_pixels); the frame gets a copy */
+    free(rs->last_px);
+    rs->last_px = px, rs->last_px_seq = 0, px = NULL;
+    if (r == SY_OK && keep_px && !(px = malloc((size_t)fw * fh * 4)))
+        r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: out of memory for a frame of %ux%u", fw, fh);
+    if (px) memcpy(px, rs->last_px, (size_t)fw * fh * 4);
+    /* the frame's camera: what the page warps the frame with (docs/WEB.md, "Binary frames") */
+    sy_web_frame_info fi = {.width = fw, .height = fh, .backend = bi, .orbit = *orbit,
+                            .flags = (cls->caps & SY_CAP_PROGRESSIVE) ? SY_WEB_FRAME_PROGRESSIVE : 0};
+    if (r == SY_OK) r = sy_viewport_camera_view(rs->vp, w->d.scene, fw, fh, &fi.view, err);
+    fi.view.clip_count = 0;
+    sy_mediator_stats st = {0};
+    sy_context *ctx = NULL;
+    if (r == SY_OK && sy_context_pool_get(rs->pool, w->d.scene, cls->name, NULL, w->d.root.id, &ctx, NULL) == SY_OK)
+        sy_context_stats(ctx, &st);
+    /* the depth channel: the view's coded one again for a refinement, else coded anew */
+    bool reuse = r == SY_OK && depth && (fi.flags & SY_WEB_FRAME_PROGRESSIVE) && rs->dz && rs->dz_w == fw &&
+                 rs->dz_h == fh && rs->dz_backend == bi && same_camera(&rs->dz_view, &fi.view) &&
+                 st.samples > rs->dz_samples;
+    if (r == SY_OK && !reuse) {
+        free(rs->dz);
+        rs->dz = NULL, rs->dz_len = 0, rs->dz_key = 0;
+        if (depth &&
+            (r = sy_web_frame_depth_code(depth, fw, fh, &rs->dz, &rs->dz_len, &rs->dz_min, &rs->dz_max, err)) == SY_OK)
+            rs->dz_w = fw, rs->dz_h = fh, rs->dz_backend = bi, rs->dz_view = fi.view, rs->dz_key = ++rs->dz_keys;
+    }
+    rs->dz_samples = st.samples;
+    uint8_t *buf = NULL;
+    size_t len = 0;
+    if (r == SY_OK)
+        r = sy_web_frame_pack_coded(&fi, jpeg, jlen, rs->dz, rs->dz_len, rs->dz_min, rs->dz_max, LWS_PRE, &buf, &len, err);
+    *ms = (sy_time_now() - t0) * 1e3; /* render, display chain, JPEG, depth */
+    free(jpeg);
+    free(depth);
+    if (r != SY_OK) {
+        free(px);
+        return r;
+    }
+    web_frame *f = calloc(1, sizeof *f);
+    if (!f) {
+        free(buf);
+        free(px);
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: out of memory for a frame of %zu bytes", len);
+    }
+    /* the samples and the time are known only now: patched into the packed header */
+    uint8_t *h = buf + LWS_PRE;
+    uint32_t spp = (uint32_t)(st.samples > UINT32_MAX ? UINT32_MAX : st.samples);
+    float fms = (float)*ms;
+    uint64_t seq = ++rs->seq;
+    memcpy(h + 16, &spp, 4); /* little-endian hosts (x86-64, arm64) */
+    memcpy(h + 20, &fms, 4);
+    memcpy(h + 24, &seq, 8);
+    f->buf = buf;
+    f->refs = 1, f->seq = seq, f->gen = gen, f->len = len;
+    f->rgba = px, f->width = fw, f->height = fh, f->backend = bi;
+    f->jpeg_len = fi.jpeg_len, f->depth_len = fi.depth_len, f->depth_key = fi.depth_len ? rs->dz_key : 0;
+    rs->last_px_seq = seq;
+    publish_frame(w, f);
+    return SY_OK;
+}
+
 /* One frame through the frame-time governor (core/sy_governor.h): plans it for the display size,
  * renders what the plan says, reports its time. *again: plan again without waiting for input;
  * *wait_ms > 0: plan again after that long (the view is settling). */
@@ -280,82 +359,22 @@ static sy_result render_frame(sy_web *w, render_state *rs, const sy_interactive_
     if (sy_interactive_apply_filter(rs->ia, rs->pool, w->d.scene, w->d.root.id, cls, in->filter, in->threshold,
                                     in->filter_version, gf.filter, NULL, &ferr) != SY_OK)
         snprintf(fstatus, sizeof fstatus, "filter: %.200s", ferr.message);
-    uint8_t *px = NULL, *jpeg = NULL;
+    uint8_t *px = NULL;
     float *depth = NULL;
-    size_t jlen = 0;
     uint32_t contexts = sy_context_pool_size(rs->pool);
-    /* video viewers get the pixels (each one's encoder runs as its frame is sent); JPEG is made
-     * only while a viewer takes it (or none said yet) */
     pthread_mutex_lock(&w->mu);
-    bool keep_px = w->video_viewers > 0, want_jpeg = w->jpeg_viewers > 0 || !w->video_viewers;
     double encode_per_px = w->encode_per_px_ms;
     pthread_mutex_unlock(&w->mu);
-    double t0 = sy_time_now();
+    double t0 = sy_time_now(), ms = 0;
     r = render_rgba8(w, rs, rs->win, gf.width, gf.height, gf.samples, gf.preview, &px, &depth, err);
-    if (r == SY_OK && want_jpeg) r = sy_jpeg_encode_rgba8(px, gf.width, gf.height, w->d.quality, &jpeg, &jlen, err);
-    /* the render thread keeps the newest pixels (republish_with_pixels); the frame gets a copy */
-    free(rs->last_px);
-    rs->last_px = px, rs->last_px_seq = 0, px = NULL;
-    if (r == SY_OK && keep_px && !(px = malloc((size_t)gf.width * gf.height * 4)))
-        r = sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: out of memory for a frame of %ux%u", gf.width, gf.height);
-    if (px) memcpy(px, rs->last_px, (size_t)gf.width * gf.height * 4);
-    /* the frame's camera: what the page warps the frame with (docs/WEB.md, "Binary frames") */
-    sy_web_frame_info fi = {.width = gf.width, .height = gf.height, .backend = bi, .orbit = in->orbit,
-                            .flags = (cls->caps & SY_CAP_PROGRESSIVE) ? SY_WEB_FRAME_PROGRESSIVE : 0};
-    if (r == SY_OK) r = sy_viewport_camera_view(rs->vp, w->d.scene, gf.width, gf.height, &fi.view, err);
-    fi.view.clip_count = 0;
-    sy_mediator_stats st = {0};
-    sy_context *ctx = NULL;
-    if (r == SY_OK && sy_context_pool_get(rs->pool, w->d.scene, cls->name, NULL, w->d.root.id, &ctx, NULL) == SY_OK)
-        sy_context_stats(ctx, &st);
-    /* the depth channel: the view's coded one again for a refinement, else coded anew */
-    bool reuse = r == SY_OK && depth && (fi.flags & SY_WEB_FRAME_PROGRESSIVE) && rs->dz && rs->dz_w == gf.width &&
-                 rs->dz_h == gf.height && rs->dz_backend == bi && same_camera(&rs->dz_view, &fi.view) &&
-                 st.samples > rs->dz_samples;
-    if (r == SY_OK && !reuse) {
-        free(rs->dz);
-        rs->dz = NULL, rs->dz_len = 0, rs->dz_key = 0;
-        if (depth &&
-            (r = sy_web_frame_depth_code(depth, gf.width, gf.height, &rs->dz, &rs->dz_len, &rs->dz_min, &rs->dz_max, err)) == SY_OK)
-            rs->dz_w = gf.width, rs->dz_h = gf.height, rs->dz_backend = bi, rs->dz_view = fi.view, rs->dz_key = ++rs->dz_keys;
-    }
-    rs->dz_samples = st.samples;
-    uint8_t *buf = NULL;
-    size_t len = 0;
-    if (r == SY_OK)
-        r = sy_web_frame_pack_coded(&fi, jpeg, jlen, rs->dz, rs->dz_len, rs->dz_min, rs->dz_max, LWS_PRE, &buf, &len, err);
-    double ms = (sy_time_now() - t0) * 1e3; /* render, display chain, JPEG, depth */
-    free(jpeg);
-    free(depth);
-    if (r != SY_OK) {
-        free(px);
-        return r;
-    }
-    /* a frame that translated the scene for a new context says nothing about the next ones */
+    if (r == SY_OK) r = publish_rendered(w, rs, cls, bi, &in->orbit, gf.width, gf.height, px, depth, gen, t0, &ms, err);
+    else free(px), free(depth);
+    if (r != SY_OK) return r;
     /* the governor is told the frame's whole cost: with what the viewers' encoders on the network
-     * thread take for a frame of this size (sy_web_cost.h) */
+     * thread take for a frame of this size (sy_web_cost.h); a frame that translated the scene for
+     * a new context says nothing about the next ones */
     sy_interactive_report(rs->ia, &gf, sy_web_frame_cost_ms(ms, encode_per_px, gf.width, gf.height),
                           sy_context_pool_size(rs->pool) != contexts);
-    web_frame *f = calloc(1, sizeof *f);
-    if (!f) {
-        free(buf);
-        free(px);
-        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "web: out of memory for a frame of %zu bytes", len);
-    }
-    /* the samples and the time are known only now: patched into the packed header */
-    uint8_t *h = buf + LWS_PRE;
-    uint32_t spp = (uint32_t)(st.samples > UINT32_MAX ? UINT32_MAX : st.samples);
-    float fms = (float)ms;
-    uint64_t seq = ++rs->seq;
-    memcpy(h + 16, &spp, 4); /* little-endian hosts (x86-64, arm64) */
-    memcpy(h + 20, &fms, 4);
-    memcpy(h + 24, &seq, 8);
-    f->buf = buf;
-    f->refs = 1, f->seq = seq, f->gen = gen, f->len = len;
-    f->rgba = px, f->width = gf.width, f->height = gf.height, f->backend = bi;
-    f->jpeg_len = fi.jpeg_len, f->depth_len = fi.depth_len, f->depth_key = fi.depth_len ? rs->dz_key : 0;
-    rs->last_px_seq = seq;
-    publish_frame(w, f);
     set_status(w, fstatus);
     *again = true; /* the governor says what comes next */
     return SY_OK;
@@ -411,13 +430,15 @@ static void render_live(sy_web *w, render_state *rs, const sy_interactive_input 
 }
 
 /* Before the first page: the initial back-end translates the scene with the governor's first frame
- * of the start view for the largest display (a quarter of -w x -h, the preview level; thrown away),
- * so that a page's first picture costs one coarse frame, not the translation (DamagedHelmet with
- * Whitted: 4.8 s before anything showed), and what a back-end sizes by the frame is made too; then
- * renders that frame again and reports its time to the governor, so the page's first frame is
- * planned with a cost model (within the budget) rather than at the quarter size blind (the
- * rasterizer's 256 x 192 frame of DamagedHelmet took 2.1-3.2 s on the loaded 2-core machine).
- * Logged with its times; a failure is only logged (the live frames report it to the pages). */
+ * of the start view for the largest display (a quarter of -w x -h, the preview level), so that a
+ * page's first picture costs one coarse frame, not the translation (DamagedHelmet with Whitted:
+ * 4.8 s before anything showed), and what a back-end sizes by the frame is made too; then renders
+ * that frame again and reports its time to the governor, so the page's first frame is planned
+ * with a cost model (within the budget) rather than at the quarter size blind (the rasterizer's
+ * 256 x 192 frame of DamagedHelmet took 2.1-3.2 s on the loaded 2-core machine). That second
+ * frame is published as the newest frame: the first picture of a page that loads before any other
+ * frame was made (docs/WEB.md, "The first picture"). Logged with its times; a failure is only
+ * logged (the live frames report it to the pages). */
 static void warm_up(sy_web *w, render_state *rs)
 {
     pthread_mutex_lock(&w->mu);
@@ -439,12 +460,16 @@ static void warm_up(sy_web *w, render_state *rs)
     for (int k = 0; k < 2 && r == SY_OK; ++k) {
         uint8_t *px = NULL;
         float *depth = NULL; /* asked for as the live frames ask for it */
-        double t = sy_time_now();
+        double t = sy_time_now(), packed_ms = 0;
         r = render_rgba8(w, rs, rs->win, fw, fh, gf.samples ? gf.samples : 1, gf.preview > 0 ? gf.preview : 1.0f, &px,
                          &depth, &err);
         ms[k] = (sy_time_now() - t) * 1e3;
-        free(px);
-        free(depth);
+        /* the second: the newest frame until a page's own (sent at once to a page whose display
+         * has its shape; /api/latest.jpg serves it while a page loads) */
+        if (k == 1 && r == SY_OK)
+            r = publish_rendered(w, rs, cls, rs->backend_applied, &o, fw, fh, px, depth, 0, t, &packed_ms, &err);
+        else
+            free(px), free(depth);
     }
     if (r != SY_OK) {
         sy_log(SY_LOG_WARNING, "web", NULL, "warming up %s: %s", name, err.message);

@@ -48,6 +48,7 @@ struct web_conn {
     uint64_t answered_id;
     bool hello_sent;
     bool sized;                  /* frames go to a viewer once it said its size (with "v": 3) */
+    bool framed;                 /* it was given a frame (its first must have its display's shape) */
     bool old_page, refusal_sent; /* a page that does not read frame format 3 (no "v" in its size message, or a lower one) */
     uint32_t old_version;        /* the format it reads (1: no "v") */
     delayed_msg delayed[WS_DELAYED];
@@ -610,6 +611,12 @@ static int ws_writeable(sy_web *w, web_conn *c)
                  w->clock.playing ? "true" : "false", w->clock.loop ? "true" : "false", w->clock.speed,
                  w->clip < w->clip_count ? (int)w->clip : -1);
     }
+    /* a viewer's first frame has its display's shape (within 2 %): the page shows a frame over its
+     * whole canvas, so a frame made for another display (the warm-up's, another viewer's) waits
+     * for the one the render thread makes for this display */
+    double shape = fresh && !c->framed && w->display_w && f->height
+                       ? (double)f->width * w->display_h / ((double)f->height * w->display_w) : 1.0;
+    if (shape > 1.02 || shape < 1.0 / 1.02) fresh = false, f->refs--; /* w->latest holds its own reference */
     pthread_mutex_unlock(&w->mu);
     if (fresh && !c->sized) sy_webi_frame_release(w, f), fresh = false;
     if (clock[0]) {
@@ -638,7 +645,7 @@ static int ws_writeable(sy_web *w, web_conn *c)
         if (c->queued_n && c->queued[c->queued_head].due <= now) {
             queued_frame q = c->queued[c->queued_head];
             c->queued_head = (c->queued_head + 1) % WS_QUEUED, c->queued_n--;
-            c->sent_seq = q.f->seq;
+            c->sent_seq = q.f->seq, c->framed = true;
             if (send_frame(w, c, q.f, q.answered)) return -1;
             if (c->queued_n) lws_callback_on_writable(c->wsi);
         }
@@ -647,7 +654,7 @@ static int ws_writeable(sy_web *w, web_conn *c)
     }
     if (!fresh) return 0;
     /* the input this frame answers: the client's newest one that reached the mailbox before it */
-    c->sent_seq = f->seq;
+    c->sent_seq = f->seq, c->framed = true;
     return send_frame(w, c, f, answered_by(c, f->gen));
 }
 

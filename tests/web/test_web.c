@@ -7,6 +7,8 @@
  *                 a foreign Host is refused (DNS rebinding)
  *   web_still     /api/frame.jpg?w=&h= is a JPEG of that size that is not uniform; bad sizes get 400
  *                 with the reason; without Origin only Sec-Fetch-Site: same-origin gets it (403 else)
+ *   web_latest    /api/latest.jpg before any viewer: the render thread's warm-up frame (the shape of
+ *                 the largest display), 204 until it is made; cross-site or no Origin: 403
  *   web_routes    a GET route and a POST route run on the render thread (the body arrives whole);
  *                 a body over the limit gets 413; garbage, huge headers and cut-off requests
  *                 leave the server serving
@@ -132,6 +134,7 @@ int main(int argc, char **argv)
     uint16_t port = sy_web_port(s.web);
     int failed = 0;
     if (!strcmp(which, "page") || !strcmp(which, "all")) failed |= test_page(port);
+    if (!strcmp(which, "latest") || !strcmp(which, "all")) failed |= test_latest(port); /* before any viewer */
     if (!strcmp(which, "still") || !strcmp(which, "all")) failed |= test_still(port);
     if (!strcmp(which, "routes") || !strcmp(which, "all")) failed |= test_routes(port);
     if (!strcmp(which, "stream") || !strcmp(which, "all")) failed |= test_stream(port);

@@ -1,5 +1,5 @@
 /* test_web_http.c — test_web's HTTP parts (test_web.c lists what each checks): web_page (the page,
- * 404, a foreign Host), web_still (/api/frame.jpg), web_routes (application routes, limits, broken
+ * 404, a foreign Host), web_still (/api/frame.jpg), web_latest (/api/latest.jpg), web_routes (application routes, limits, broken
  * requests), web_clientfiles (/client/ serves the page's own files only). */
 #include "web_test.h"
 int test_page(uint16_t port)
@@ -49,6 +49,57 @@ int test_still(uint16_t port)
         if (a.status != (i == 0 ? 200 : 403)) fprintf(stderr, "still with '%s': %d\n", site[i], a.status);
         CHECK(a.status == (i == 0 ? 200 : 403));
         free(a.body);
+    }
+    return 0;
+}
+
+/* /api/latest.jpg: the newest frame's JPEG, no rendering. Before any viewer it is the warm-up's
+ * frame (a quarter of the largest display, 1920 x 1200 here: its 1.6 shape), published by the
+ * render thread as it starts (polled for: 204 until then, at most 60 s); it shows the view, so
+ * only the page's own origin (or Sec-Fetch-Site: same-origin) gets it. Then a viewer's first
+ * frame on the socket has its display's shape. */
+int test_latest(uint16_t port)
+{
+    http_answer a;
+    int status = 0;
+    for (int i = 0; i < 600 && status != 200; ++i) {
+        CHECK(web_get(port, "/api/latest.jpg", NULL, &a) == 0);
+        status = a.status;
+        if (status != 200) free(a.body), usleep(100000);
+        CHECK_MSG(status == 200 || status == 204, "GET /api/latest.jpg: %d", status);
+    }
+    CHECK_MSG(status == 200, "no latest frame after 60 s");
+    CHECK(strcasestr(a.head, "content-type: image/jpeg") != NULL);
+    sy_error err = {0};
+    uint8_t *px = NULL;
+    uint32_t jw = 0, jh = 0;
+    CHECK_OK(sy_jpeg_decode_rgba8(a.body, a.body_len, 0, &px, &jw, &jh, &err), err);
+    free(px);
+    CHECK_MSG(jh > 0 && fabs((double)jw / jh - 1.6) < 0.032 && web_check_jpeg(a.body, a.body_len, jw, jh) == 0,
+              "the latest frame is %ux%u, not the warm-up's of a 1920 x 1200 display", jw, jh);
+    free(a.body);
+    const char *site[] = {"Sec-Fetch-Site: same-origin\r\n", "Sec-Fetch-Site: cross-site\r\n", ""};
+    for (int i = 0; i < 3; ++i) {
+        char req[512];
+        snprintf(req, sizeof req, "GET /api/latest.jpg HTTP/1.1\r\nHost: 127.0.0.1:%u\r\n%sConnection: close\r\n\r\n", port, site[i]);
+        CHECK(web_http(port, req, NULL, 0, &a) == 0);
+        CHECK_MSG(a.status == (i == 0 ? 200 : 403), "latest with '%s': %d", site[i], a.status);
+        free(a.body);
+    }
+    /* a viewer's first frame has its display's shape: the warm-up frame (1.6) is never sent to
+     * an 80 x 60 display (4:3), which waits for its own; a 960 x 600 one gets a 1.6 frame */
+    static const uint32_t disp[2][2] = {{80, 60}, {960, 600}};
+    for (int k = 0; k < 2; ++k) {
+        char path[64];
+        snprintf(path, sizeof path, "/ws?w=%u&h=%u&v=3", disp[k][0], disp[k][1]);
+        sy_web_client_opts o = {.host = "127.0.0.1", .port = port, .path = path};
+        sy_web_client *c = NULL;
+        sy_web_frame_info fi;
+        CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err), err);
+        CHECK_OK(sy_web_client_next_frame(c, 60000, &fi, NULL, NULL, &err), err);
+        sy_web_client_close(c);
+        CHECK_MSG(labs((long)fi.width * disp[k][1] - (long)fi.height * disp[k][0]) <= 2 * (long)disp[k][0],
+                  "a %ux%u display's first frame is %ux%u", disp[k][0], disp[k][1], fi.width, fi.height);
     }
     return 0;
 }

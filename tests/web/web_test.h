@@ -96,6 +96,7 @@ int web_next_frame(sy_web_client *c, sy_web_frame_info *fi, uint8_t **j, size_t 
 /* >>the parts, one ctest each (0 passed, 1 failed): test_web_http.c */
 int test_page(uint16_t port);
 int test_still(uint16_t port);
+int test_latest(uint16_t port);
 int test_routes(uint16_t port);
 int test_client_files(void);
 /* test_web_stream.c */
