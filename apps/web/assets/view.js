@@ -542,11 +542,11 @@
 
   const listeners = []; // window.sy.on: the server's text messages, parsed
   let lastHello = null;
-  // the server's text messages while the page loads: until DOMContentLoaded, which comes after
-  // every (deferred) script ran (readyState is already "interactive" while they run)
+  // the server's text messages while the page loads: until index.html's "sy-scripts-loaded", which
+  // comes after every one of the page's scripts ran
   const early = [];
-  let pageLoading = true;
-  document.addEventListener("DOMContentLoaded", function () { pageLoading = false; early.length = 0; });
+  let pageLoading = !(window.syEarly && window.syEarly.scriptsLoaded);
+  document.addEventListener("sy-scripts-loaded", function () { pageLoading = false; early.length = 0; });
   function send(o) {
     if (ws && ws.readyState === 1) ws.send(JSON.stringify(o));
   }
