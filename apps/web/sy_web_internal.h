@@ -93,7 +93,8 @@ typedef struct web_reply {
 } web_reply;
 
 #define WEB_ACTIONS_MAX 256u /* actions queued, all connections (more are dropped with a log line) */
-#define WEB_REPLIES_MAX 64u  /* answers waiting, all connections (more are dropped with a log line) */
+#define WEB_REPLIES_MAX 64u  /* answers waiting, all connections (more: the oldest is dropped, with a log line) */
+#define WEB_REPLIES_PER_CONN 16u /* answers waiting for one connection (more: the new one is dropped, logged) */
 /* One "tree" answer (sy_web_scene.c): at most WEB_TREE_PAGE of the listed node's children (or of
  * the roots) from the asked offset, each opened (its children listed below it, depth first) while
  * it has at most WEB_TREE_PAGE children and the answer stays within WEB_TREE_MAX nodes; the others

@@ -21,8 +21,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Queues the JSON o (deleted here) for connection conn; dropped with a log line when WEB_REPLIES_MAX
- * answers wait already. */
+/* Queues the JSON o (deleted here) for connection conn. At most WEB_REPLIES_PER_CONN wait for one
+ * connection (a page that does not read its answers loses its newest, with a log line); when
+ * WEB_REPLIES_MAX wait in all, the oldest gives way (mostly an answer for a page that left, which
+ * the network thread drops when it next runs: 80 pages that asked and left while the render thread
+ * was busy filled the queue before it ran, and the next page's answer was dropped, `web_scene`
+ * under load). */
 static void post_reply(sy_web *w, const web_action *a, cJSON *o)
 {
     char *s = cJSON_PrintUnformatted(o);
@@ -34,13 +38,27 @@ static void post_reply(sy_web *w, const web_action *a, cJSON *o)
         return;
     }
     y->conn = a->conn, y->text = s;
+    web_reply *oldest = NULL;
     pthread_mutex_lock(&w->mu);
-    bool full = w->reply_count >= WEB_REPLIES_MAX;
-    if (!full) *w->replies_tail = y, w->replies_tail = &y->next, w->reply_count++;
+    uint32_t mine = 0;
+    for (const web_reply *r = w->replies; r; r = r->next) mine += r->conn == a->conn;
+    bool over = mine >= WEB_REPLIES_PER_CONN;
+    if (!over) {
+        if (w->reply_count >= WEB_REPLIES_MAX) {
+            oldest = w->replies;
+            w->replies = oldest->next, w->reply_count--;
+            if (!w->replies) w->replies_tail = &w->replies;
+        }
+        *w->replies_tail = y, w->replies_tail = &y->next, w->reply_count++;
+    }
     pthread_mutex_unlock(&w->mu);
-    if (full) {
+    if (oldest) {
+        sy_log(SY_LOG_WARNING, "web", NULL, "%u answers wait already: the oldest dropped", WEB_REPLIES_MAX);
+        free(oldest->text), free(oldest);
+    }
+    if (over) {
         free(s), free(y);
-        sy_log(SY_LOG_WARNING, "web", a->peer, "%u answers wait already: one dropped", WEB_REPLIES_MAX);
+        sy_log(SY_LOG_WARNING, "web", a->peer, "%u answers wait for this viewer already: one dropped", WEB_REPLIES_PER_CONN);
         return;
     }
     sy_webi_wake_network(w);
