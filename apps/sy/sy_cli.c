@@ -254,6 +254,8 @@ static const char usage_text[] =
             "           selection, section plane, exposure, filter or back-end)\n"
             "          [--delay-ms N]   (tests only: N ms of added network delay each way)\n"
             "          [--clip NAME|INDEX]   (the clip the page's timeline plays; default: as sy render --at)\n"
+            "          [--bookmarks FILE]   (the saved views pages share: the panel's Saved views, Shift+1..9 recalls;\n"
+            "           default SCENE.bookmarks beside the scene, the file sy view keeps)\n"
             "  sy bench web [SCENE] [-b BACKEND] [-w W] [-h H] [--repeats N]   (input-to-frame latency, loopback)\n"
             "  sy bench stream [SCENE] [-b BACKEND] [-w W] [-h H] [--repeats FPS]   (sy web's JPEG vs VP8 / VP9: bytes at equal SSIM, 10 s orbit)\n"
             "  sy bench sync [--nodes N] [--tris T] [--repeats R]\n"

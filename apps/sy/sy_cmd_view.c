@@ -82,11 +82,7 @@ int sy_cmd_view(int argc, char **argv)
     va.spec.clip_cap = cut.clip_cap;
     memcpy(va.spec.clip_cap_color, cut.clip_cap_color, sizeof va.spec.clip_cap_color);
     char *marks = NULL; /* the saved views beside the scene file (not for the built-in demo) */
-    if (!bookmarks && strcmp(scene, "demo") && (marks = malloc(strlen(scene) + 11))) {
-        sprintf(marks, "%s.bookmarks", scene);
-        bookmarks = marks;
-    }
-    va.bookmarks = bookmarks;
+    va.bookmarks = sy_cli_bookmarks_file(scene, bookmarks, &marks);
     sy_result r = overlay ? sy_cli_add_overlay(&ld, overlay, composite, &va.spec, &err) : SY_OK;
     if (r == SY_OK) r = sy_view_run(&va, &err);
     free(marks);

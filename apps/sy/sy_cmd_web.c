@@ -25,6 +25,7 @@ int sy_cmd_web(int argc, char **argv)
 {
     const char *backend = NULL, *camera = NULL, *listen = NULL, *filter = NULL, *scene = NULL;
     const char *clip = NULL; /* --clip NAME|INDEX: the clip the timeline plays (sy_cli_default_clip without it) */
+    const char *bookmarks = NULL; /* --bookmarks FILE: the saved views (default: SCENE.bookmarks, as sy view) */
     uint32_t w = 1920, h = 1200, quality = 80, delay_ms = 0;
     float threshold = 0.0f;
     double budget = 0; /* 0: the governor's default (33 ms) */
@@ -37,7 +38,7 @@ int sy_cmd_web(int argc, char **argv)
         SY_CLI_OPT_FLAG("client-render", OPT_WEB_CLIENT_RENDER, &client_render),
         SY_CLI_OPT_FLAG("no-temporal", OPT_NO_TEMPORAL, &no_temporal),
         SY_CLI_OPT_FLAG("read-only", OPT_WEB_READ_ONLY, &read_only), /* viewers look, they do not change the scene */
-        SY_CLI_OPT_TEXT("clip", OPT_CLIP, &clip),
+        SY_CLI_OPT_TEXT("clip", OPT_CLIP, &clip), SY_CLI_OPT_TEXT("bookmarks", OPT_BOOKMARKS, &bookmarks),
         SY_CLI_OPT_UINT("delay-ms", OPT_WEB_DELAY, &delay_ms, 0, 10000)}; /* tests only: added network delay each way */
     sy_cli_parser p = {SY_CLI_ARGS("web", argc, argv, opts), .w = &w, .h = &h, .min_size = 1, .view = true};
     if (sy_cli_parse(&p) != -1) return p.status;
@@ -51,10 +52,13 @@ int sy_cmd_web(int argc, char **argv)
                      .backend = backend, .listen = listen, .max_width = w, .max_height = h, .quality = (int)quality,
                      .filter = filter, .threshold = threshold, .budget_ms = budget, .delay_ms = delay_ms,
                      .no_temporal = no_temporal, .read_only = read_only, .clip = sy_cli_default_clip(&ld)};
+    char *marks = NULL; /* the saved views beside the scene file (not for the built-in demo) */
+    d.bookmarks = sy_cli_bookmarks_file(scene, bookmarks, &marks);
     if (clip) { /* as sy render --clip: an unknown clip is a usage error naming the clips there are */
         sy_error fe = {0};
         if (!sy_scene_count(ld.scene, SY_TYPE_ANIMATION) || sy_animation_find(ld.scene, clip, &d.clip, &fe) != SY_OK) {
             fprintf(stderr, "sy web: error: --clip %s: %s\n", clip, fe.message[0] ? fe.message : "the scene has no animations");
+            free(marks);
             sy_cli_loaded_free(&ld);
             return 2;
         }
@@ -97,6 +101,7 @@ int sy_cmd_web(int argc, char **argv)
 #ifdef SY_WEB_HAVE_CULL
     sy_web_cull_destroy(cull);
 #endif
+    free(marks);
     sy_cli_loaded_free(&ld);
     return r == SY_OK ? 0 : sy_cli_fail(&err);
 }

@@ -526,3 +526,12 @@ sy_result sy_cli_add_overlay(loaded *ld, const char *arg, const char *composite,
     sy_gltf_info_free(&info);
     return SY_OK;
 }
+
+const char *sy_cli_bookmarks_file(const char *scene, const char *given, char **owned)
+{
+    *owned = NULL;
+    if (given) return given;
+    if (!strcmp(scene, "demo") || !(*owned = malloc(strlen(scene) + sizeof ".bookmarks"))) return NULL;
+    sprintf(*owned, "%s.bookmarks", scene);
+    return *owned;
+}

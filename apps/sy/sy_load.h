@@ -68,6 +68,10 @@ extern sy_load_options sy_cli_load_opts;
  * missing part, NaN, eye == target, up parallel to the view, a range; --look-at with --orbit) on
  * stderr. */
 int sy_cli_view_option(int c, const char *value);
+/* The saved views' file of sy view and sy web (sy_bookmarks.h): given (--bookmarks FILE) as it is,
+ * else SCENE.bookmarks beside the scene, none (NULL) for the built-in demo. *owned: what the caller
+ * frees (NULL when nothing was allocated); NULL also when out of memory. */
+const char *sy_cli_bookmarks_file(const char *scene, const char *given, char **owned);
 /* --hide, --isolate or --select (OPT_HIDE, OPT_ISOLATE, OPT_SELECT) with its NODE into
  * sy_cli_load_opts.nodes. Returns 0, or 2 after a usage error (an empty value, too many) on stderr. */
 int sy_cli_node_option(int c, const char *value);

@@ -190,6 +190,7 @@ sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err)
                                                      desc->threshold > 0 ? desc->threshold : 0.0f, &w->in, err)))
         sy_error_prefix(err, "web");
     if (r == SY_OK) sy_orbit_matrix(&w->in.orbit, &w->view);
+    if (r == SY_OK) r = sy_webi_views_init(w, desc, err);
     if (r != SY_OK) {
         sy_web_destroy(w);
         return r;
@@ -330,6 +331,7 @@ void sy_web_destroy(sy_web *w)
     }
     free(w->routes);
     free(w->clips);
+    free(w->bookmarks);
     free(w->clip_range);
     free(w->clip_names);
     pthread_mutex_destroy(&w->mu);

@@ -12,8 +12,10 @@
  * Pages may also pick (sy_viewport_pick), show, hide, select and isolate nodes, set section planes
  * and the exposure, read the scene's hierarchy (docs/WEB.md, "The WebSocket protocol"), and play,
  * pause and scrub the scene clock when the scene has animations (the server then sets the scene's
- * time with sy_scene_set_time and commits, on the render thread; "The timeline"); a read_only
- * server refuses every change but the camera's and the clock's (view changes).
+ * time with sy_scene_set_time and commits, on the render thread; "The timeline"), and save and
+ * recall views (bookmarks, sy_bookmarks.h: up to 9 that every page shares, kept in the file
+ * sy_web_desc.bookmarks names as sy view keeps them; "Saved views"); a read_only server refuses
+ * every change but the camera's and the clock's (view changes; recalling a saved view is one).
  *
  * Threads: sy_web_create starts the network thread (the libwebsockets service loop); the thread
  * that calls sy_web_run renders, and is the only one that touches the scene while it runs. The two
@@ -113,6 +115,10 @@ typedef struct sy_web_desc {
     bool read_only;           /**< viewers look (camera, scene clock, pick, tree, stills) but cannot change visibility,
                                    selection, section planes, exposure, display filter or back-end: those
                                    messages are refused with a log line (sy web --read-only) */
+    const char *bookmarks;    /**< the saved views' file (sy_bookmarks.h; sy view's, sy web: SCENE.bookmarks or
+                                   --bookmarks): read at create (missing: no views yet; unreadable: a warning, and
+                                   views are then kept in memory only, the file left as it is), rewritten on each
+                                   save; NULL: views last as long as the server */
     sy_animation clip;        /**< the clip the timeline plays ({0}: every clip together, as sy_scene_set_time;
                                    sy web: sy_cli_default_clip or --clip); a page may choose another ("anim") */
     const sy_web_route *routes; /**< extra routes (the array is copied; its strings and user pointers must outlive the server) */
@@ -124,9 +130,10 @@ typedef struct sy_web sy_web;
 
 /** Binds the address (apps/web/sy_web_gate.h takes the connections until their request is whole)
  * and starts the network thread. The server adds nothing to the scene; it changes only node flags
- * a page asks for (visibility, selection, isolation; not with read_only) and, once a page moves the
- * scene clock, the animated fields (sy_scene_set_time), and then commits the scene, on the render
- * thread between frames (the application commits its own changes).
+ * a page asks for (visibility, selection, isolation; not with read_only), once a page moves the
+ * scene clock the animated fields (sy_scene_set_time), and the camera's field of view when a page
+ * recalls a view saved with another one, and then commits the scene, on the render thread between
+ * frames (the application commits its own changes).
  * Fails with a message naming the address when it cannot be bound, the back-end when it is not
  * registered, the option when a limit is out of range. */
 sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err);

@@ -3,6 +3,8 @@
 #include "sy_web_check.h"
 #include "sy_web_assets.h"
 
+#include "sy_bookmarks.h"
+
 #include <arpa/inet.h>
 #include <cjson/cJSON.h>
 #include <math.h>
@@ -456,6 +458,7 @@ bool sy_web_input_changes_scene(const sy_web_input *in)
     case SY_WEB_INPUT_ENVIRONMENT:
     case SY_WEB_INPUT_FILTER: return true;
     case SY_WEB_INPUT_KEY: return in->key != 'r'; /* back-ends and the filter keys; R is the camera */
+    case SY_WEB_INPUT_VIEW: return in->on;        /* a save; a recall is the camera */
     default: return false;
     }
 }
@@ -583,6 +586,14 @@ sy_result sy_web_parse_input(const char *text, size_t len, sy_web_input *out, sy
         out->type = SY_WEB_INPUT_PLAY;
         if (!cJSON_GetObjectItemCaseSensitive(m, "on") || !json_bool(m, "on", &out->on))
             r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "play: on must be true or false");
+    } else if (!strcmp(type, "view")) {
+        out->type = SY_WEB_INPUT_VIEW;
+        double n = 0;
+        if (!json_num(m, "n", 1, SY_BOOKMARKS_MAX, &n) || n != floor(n))
+            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "view: n must be a saved view's number, 1..%d", SY_BOOKMARKS_MAX);
+        else if (!json_bool(m, "save", &out->on))
+            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "view: save must be true or false");
+        out->slot = (uint32_t)n;
     } else if (!strcmp(type, "filter") || !strcmp(type, "environment")) {
         out->type = type[0] == 'f' ? SY_WEB_INPUT_FILTER : SY_WEB_INPUT_ENVIRONMENT;
         const cJSON *f = cJSON_GetObjectItemCaseSensitive(m, "name");

@@ -143,8 +143,10 @@ typedef enum sy_web_input_type {
     SY_WEB_INPUT_TIME,     /**< {"t":"time","s":SECONDS}: the scene clock to that time (a; the range is the server's check) */
     SY_WEB_INPUT_PLAY,     /**< {"t":"play","on":BOOL}: the scene clock plays (on) or pauses */
     SY_WEB_INPUT_ENVIRONMENT, /**< the environment by name (filter: "scene", "studio", "none"; judged by the server) */
-    SY_WEB_INPUT_ANIM      /**< {"t":"anim","clip":N}: the clip the scene clock plays (a: N, an index of the
+    SY_WEB_INPUT_ANIM,     /**< {"t":"anim","clip":N}: the clip the scene clock plays (a: N, an index of the
                             *   hello's "clips", -1 every clip; the index's range is the server's check) */
+    SY_WEB_INPUT_VIEW      /**< {"t":"view","n":N[,"save":true]}: a saved view (sy_bookmarks.h): slot N
+                            *   (1..SY_BOOKMARKS_MAX) recalled, or (on) the view now saved there */
 } sy_web_input_type;
 
 /** Node ids a page may name: 1..SY_WEB_NODE_ID_MAX (sy_node.id); unknown ones are refused later. */
@@ -171,8 +173,10 @@ typedef struct sy_web_input {
                        * older than frame format 3, refused with a status message) */
     uint32_t node;   /**< visible, select, isolate: the node id (0 only for select / isolate: all);
                       * tree: the node whose children are listed (0 or absent: the scene's roots) */
+    uint32_t slot;   /**< view: the saved view's number, 1..SY_BOOKMARKS_MAX */
     uint32_t offset; /**< tree: the first of those children (or roots) listed (0..2^31; absent: 0) */
-    bool on;         /**< visible: show; select: select; pick: select what is hit; play: play (else pause) */
+    bool on;         /**< visible: show; select: select; pick: select what is hit; play: play (else pause);
+                      *   view: save (else recall) */
     uint32_t seq;    /**< pick, tree: the page's request number, echoed in the answer (0..2^31) */
     uint32_t plane_count;             /**< clip: planes in use (0..SY_CLIP_PLANES_MAX) */
     float planes[SY_CLIP_PLANES_MAX][4]; /**< clip: {a, b, c, d}, checked by sy_clip_planes_check */
@@ -192,8 +196,10 @@ typedef struct sy_web_input {
 
 /** True for the messages that change what other viewers see beyond the camera (visibility,
  * selection, section planes, exposure, display filter, environment; keys: back-ends and filter
- * keys): refused by a read-only server (sy_web_desc.read_only). A pick with select is allowed as a
- * plain pick; the scene clock (time, play) is a view change like the camera's: every page may move it. */
+ * keys; saving a view, which every page shares and the server writes to its file): refused by a
+ * read-only server (sy_web_desc.read_only). A pick with select is allowed as a plain pick; the
+ * scene clock (time, play) and recalling a saved view are view changes like the camera's: every
+ * page may make them. */
 bool sy_web_input_changes_scene(const sy_web_input *in);
 
 /** Parses one text message (len bytes, not NUL-terminated); SY_ERR_PARSE / SY_ERR_INVALID_ARGUMENT

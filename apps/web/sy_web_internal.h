@@ -7,6 +7,7 @@
  * (sy_web_video.c: VP8 / VP9 through libvpx, one per viewer) and the encoders' cost that the
  * governor is told (sy_web_cost.c):
  *   sy_web_mailbox.c  what the two threads share (under mu): jobs, frames
+ *   sy_web_views.c    the saved views every page shares: their file, save, recall, the list
  *   sy_web_http.c     HTTP on the network thread: page, stills, routes, token, body collection
  *   sy_web_ws.c       WebSocket viewers: input messages in, newest frame out; the protocol table
  *                     and the network thread
@@ -20,6 +21,7 @@
 #include "sy_web.h"
 
 #include "sy_anim.h"
+#include "sy_bookmarks.h"
 #include "sy_interactive.h"
 #include "sy_viewport.h"
 #include "sy_web_check.h"
@@ -174,6 +176,17 @@ struct sy_web {
     uint32_t clip_count, clip;
     uint64_t clock_version;           /* played, paused, moved, stopped at an end, or a playing clock's
                                        * periodic update: sent to every page as a "clock" message */
+    /* the saved views every page shares (docs/WEB.md, "Saved views"; sy_bookmarks.h): slots
+     * 1..SY_BOOKMARKS_MAX, read from the file at create, saved and recalled by the network thread
+     * (the file rewritten there, outside mu); views_version counts saves (every page is sent the
+     * list, "views"), views_note the last save's trouble for the pages (""); fov: the camera's
+     * vertical field of view now (radians, 0: orthographic), saved with a view; fov_req: a recalled
+     * view's for the render thread to set on the camera (0: none) */
+    sy_bookmark marks[SY_BOOKMARKS_MAX + 1];
+    uint64_t views_version;
+    char views_note[200];
+    float fov, fov_req;
+    char *bookmarks;                  /* the views' file (NULL: memory only); read at create, then the network thread's */
     uint64_t conn_serial;             /* the last web_conn.serial given (network thread) */
     sy_web_stats st;                  /* the still counters */
     /* --- under mu: render thread -> network thread --- */
@@ -204,6 +217,27 @@ void sy_webi_wake_network(sy_web *w);
 void sy_webi_post_job(sy_web *w, web_job *j);
 void sy_webi_post_still(sy_web *w, web_job *j);
 bool sy_webi_job_abandoned(sy_web *w, const web_job *j);
+
+/* --- sy_web_views.c: the saved views (docs/WEB.md, "Saved views") --- */
+/* At create: the camera's field of view, the views' file read (missing: none yet; unreadable: a
+ * warning, views kept in memory only and the file left as it is). */
+sy_result sy_webi_views_init(sy_web *w, const sy_web_desc *desc, sy_error *err);
+/* What a "view" message did (sy_webi_view_message). */
+typedef enum web_view_done { WEB_VIEW_NONE, WEB_VIEW_RECALLED, WEB_VIEW_SAVED } web_view_done;
+/* Network thread, mu held: a recall sets the shared orbit (and fov_req when the view was saved
+ * with another field of view): RECALLED, an input the next frames answer; a save puts the view now
+ * in its slot: SAVED, the caller releases mu and calls sy_webi_views_write; an empty slot is
+ * logged: NONE. */
+web_view_done sy_webi_view_message(sy_web *w, const sy_web_input *in, const char *peer);
+/* Network thread, mu not held: the views rewritten to their file (a failure: logged and told to
+ * the pages in the list's "note"), then views_version bumped (the caller tells every page). */
+void sy_webi_views_write(sy_web *w, const char *peer);
+/* Network thread, mu held: the "views" message (malloc()ed JSON) when views_version is past *sent
+ * (updated), else NULL. */
+char *sy_webi_views_json(sy_web *w, uint64_t *sent);
+/* Render thread, mu not held: a recalled view's field of view set on the camera and committed;
+ * false (logged) when it could not be. */
+bool sy_webi_views_set_fov(sy_web *w, float fov);
 
 /* --- sy_web_scene.c --- */
 /* What the render thread lends to the pages' scene requests. */

@@ -539,7 +539,10 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
         bool clients = w->clients > 0 && w->display_w > 0;
         bool need_pixels = w->need_pixels;
         w->need_pixels = false;
+        float fov_req = w->fov_req; /* a recalled view's field of view (sy_web_views.c) */
+        w->fov_req = 0.0f;
         pthread_mutex_unlock(&w->mu);
+        if (fov_req > 0.0f && sy_webi_views_set_fov(w, fov_req)) rs.changed = moved = true;
         if (clock_moved) { /* the scene at the clock's time: what frames show changed */
             clock_apply(w, &rs, clock_t, clock_clip);
             rs.changed = moved = true;

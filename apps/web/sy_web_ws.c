@@ -41,6 +41,7 @@ struct web_conn {
     char peer[64];
     uint64_t sent_seq, sent_status, queued_seq;
     uint64_t sent_clock;         /* the clock_version last sent to it ("clock" message) */
+    uint64_t sent_views;         /* the views_version last sent to it ("views" message) */
     /* the client's newest inputs with the generation each got (a ring): a frame answers the newest
      * one whose generation it includes */
     uint64_t ids[WS_IDS], gens[WS_IDS];
@@ -201,6 +202,18 @@ static void ws_message(sy_web *w, web_conn *c, const char *text, size_t len)
     pthread_mutex_lock(&w->mu);
     bool input = true, clock_changed = false;
     switch (in.type) {
+    case SY_WEB_INPUT_VIEW: { /* saved views (sy_web_views.c): a recall moves the camera, a save is written */
+        web_view_done done = sy_webi_view_message(w, &in, c->peer);
+        if (done != WEB_VIEW_RECALLED) {
+            pthread_mutex_unlock(&w->mu);
+            if (done == WEB_VIEW_SAVED) {
+                sy_webi_views_write(w, c->peer);
+                lws_callback_on_writable_all_protocol(lws_get_context(c->wsi), &sy_webi_protocols[1]); /* every page's list */
+            }
+            return;
+        }
+        break;
+    }
     case SY_WEB_INPUT_PICK:
     case SY_WEB_INPUT_VISIBLE:
     case SY_WEB_INPUT_SELECT:
@@ -611,6 +624,7 @@ static int ws_writeable(sy_web *w, web_conn *c)
                  w->clock.playing ? "true" : "false", w->clock.loop ? "true" : "false", w->clock.speed,
                  w->clip < w->clip_count ? (int)w->clip : -1);
     }
+    char *views = status[0] || clock[0] ? NULL : sy_webi_views_json(w, &c->sent_views); /* the saved views, after those */
     /* a viewer's first frame has its display's shape (within 2 %): the page shows a frame over its
      * whole canvas, so a frame made for another display (the warm-up's, another viewer's) waits
      * for the one the render thread makes for this display */
@@ -619,6 +633,14 @@ static int ws_writeable(sy_web *w, web_conn *c)
     if (shape > 1.02 || shape < 1.0 / 1.02) fresh = false, f->refs--; /* w->latest holds its own reference */
     pthread_mutex_unlock(&w->mu);
     if (fresh && !c->sized) sy_webi_frame_release(w, f), fresh = false;
+    if (views) {
+        if (fresh) sy_webi_frame_release(w, f);
+        int e = ws_send_text(c->wsi, views);
+        cJSON_free(views);
+        if (e) return -1;
+        lws_callback_on_writable(c->wsi);
+        return 0;
+    }
     if (clock[0]) {
         if (fresh) sy_webi_frame_release(w, f);
         if (ws_send_text(c->wsi, clock)) return -1;

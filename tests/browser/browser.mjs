@@ -24,9 +24,10 @@
 //     the node), hides that node from the tree (the streamed canvas changes there; a pick there no
 //     longer names it), shows it again (back as it was while selected), adds a section plane (the canvas
 //     changes; with caps on in magenta, the cut faces show magenta), measures two covered points (Esc takes them away), opens the help, takes a screenshot (the download),
-//     pinches and drags with synthetic touch pointers; screenshots OUTDIR/page.png, tree.png,
-//     hidden.png, section.png, cap.png, measure.png, help.png. URL with readonly=1 (sy web --read-only):
-//     the controls that change the scene are hidden or disabled and a change sent anyway leaves
+//     pinches and drags with synthetic touch pointers, saves the view as 3 (the panel), drags away
+//     and recalls it with Shift+3 (the canvas as saved); screenshots OUTDIR/page.png, tree.png,
+//     hidden.png, section.png, cap.png, measure.png, help.png, views.png. URL with readonly=1 (sy web --read-only):
+//     the controls that change the scene (and Save) are hidden or disabled and a change sent anyway leaves
 //     the tree as it was.
 //   node browser.mjs video URL OUTDIR WIDTH HEIGHT
 //     The video stream: which codecs this chromium's WebCodecs decodes (none: exit 77 with that
@@ -638,6 +639,34 @@ try {
     }, [px, py]);
     result.touch_inputs = (await page.evaluate(() => sy.stats().last_input)) - in0;
     await settled();
+    // 8. saved views (views.js): the view now saved as 3 with the panel's Save as (listed, its
+    // button on, 4's off), a drag away (the canvas changes), Shift+3 recalls it (the canvas as it
+    // was). A read-only page has no Save (browser_test.sh: the server refuses one sent anyway)
+    const atRest = async () => { await settled(); await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)))); };
+    if (!readOnly) {
+      await atRest();
+      const savedB64 = await canvasB64('view_saved_canvas.png');
+      const v0 = await page.evaluate(() => sy.ui.views.received);
+      await page.selectOption('#sy-view-slot', '3');
+      await page.click('#sy-view-save');
+      await page.waitForFunction((n) => sy.ui.views.received > n && sy.ui.views.list.some((v) => v.n === 3), v0, { timeout: TIMEOUT });
+      result.views_saved = await page.evaluate(() => ({ list: sy.ui.views.list, kept: sy.ui.views.kept,
+        on3: !document.getElementById('sy-view-3').disabled, off4: document.getElementById('sy-view-4').disabled }));
+      await page.mouse.move(px, py); await page.mouse.down();
+      await page.mouse.move(px + 90, py + 30, { steps: 6 }); await page.mouse.up();
+      await atRest();
+      const movedB64 = await canvasB64('view_moved_canvas.png');
+      await page.keyboard.press('Shift+Digit3');
+      await page.waitForFunction(() => sy.stats().last_input > 0 && syStats.answeredInput === syStats.lastInput, null, { timeout: TIMEOUT });
+      await atRest();
+      await page.screenshot({ path: join(outDir, 'views.png') });
+      const backB64 = await canvasB64('view_recalled_canvas.png');
+      result.views = { moved: await diff(savedB64, movedB64, px, py), recalled: await diff(savedB64, backB64, px, py) };
+    } else {
+      await page.evaluate(() => sy.send({ t: 'view', n: 1, save: true })); // refused: the server logs it
+      result.views_ro = await page.evaluate(() => ({ save_hidden: getComputedStyle(document.getElementById('sy-view-save').parentNode).display === 'none',
+                                                    section: !!document.getElementById('sy-views') }));
+    }
     result.consoleErrors = consoleErrors;
     console.log(JSON.stringify(result));
   } else if (mode === 'timeline') {

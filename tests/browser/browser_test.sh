@@ -124,6 +124,7 @@ args=(web "$SCENE" -b raster --listen 127.0.0.1:0)
 [ "$mode" = converge ] && args=(web "$SCENE" -b pathtracer --quality 95 --listen 127.0.0.1:0)
 [ "$mode" = client ] || [ "$mode" = client_timeline ] && args+=(--client-render)
 [ "$mode" = warp ] && args+=(--delay-ms 100)
+[ "$mode" = tools ] && args+=(--bookmarks "$out/views.bookmarks") # the saved views' file (the page saves view 3)
 "$SY" "${args[@]}" >"$out/log" 2>"$out/err" &
 pid=$!
 . "$(dirname "$0")/../support/wait.sh" # wait_until: states, never sleeps (hang guard only)
@@ -186,6 +187,7 @@ fetched_check() {
 if [ "$mode" = tools ]; then
     browse "$url"
     cp "$out/browser.json" "$out/tools.json"
+    grep -q '^3 ' "$out/views.bookmarks" 2>/dev/null || bad "the view the page saved as 3 is not in the views' file: $(cat "$out/views.bookmarks" 2>&1)"
     # the same page from a read-only server
     "$SY" web "$SCENE" -b raster --listen 127.0.0.1:0 --read-only >"$out/log2" 2>"$out/err2" &
     pid2=$!
@@ -231,6 +233,14 @@ if [ "$mode" = tools ]; then
       if (!r.readOnly || !r.hidden_controls.sections || !r.hidden_controls.checkbox_disabled || !r.hidden_controls.badge) errs.push(`read-only page controls ${JSON.stringify(r.hidden_controls)}`);
       if (r.hidden_controls && r.hidden_controls.selected) errs.push("a read-only click selected a node");
       if (!r.still_visible) errs.push("a read-only server applied a visibility change");
+      const v = t.views, vs = t.views_saved;
+      console.log(`saved views: ${vs && vs.list.length} listed; a drag away changed ${(100 * v.moved.changed).toFixed(1)}% of the canvas, ` +
+                  `Shift+3 back: ${(100 * v.recalled.changed).toFixed(2)}% differs (mean abs diff ${v.recalled.box.toFixed(2)} at the pick)`);
+      if (!(vs && vs.kept && vs.on3 && vs.off4 && vs.list.length === 1 && vs.list[0].n === 3 && vs.list[0].fov > 0))
+        errs.push(`saving view 3: ${JSON.stringify(vs)}`);
+      if (!(v.moved.changed > 0.05)) errs.push(`the drag after saving changed ${v.moved.changed} of the canvas`);
+      if (!(v.recalled.changed < 0.005 && v.recalled.box < 4)) errs.push(`Shift+3 did not bring the saved view back: ${JSON.stringify(v.recalled)}`);
+      if (!(r.views_ro && r.views_ro.section && r.views_ro.save_hidden)) errs.push(`read-only saved views ${JSON.stringify(r.views_ro)}`);
       for (const s of [t, r]) if (s.consoleErrors.length) errs.push(`page errors: ${s.consoleErrors}`);
       if (errs.length) { console.log("FAIL: " + errs.join("; ")); process.exit(1); }
     ' "$out/tools.json" "$out/ro.json" || fail=1

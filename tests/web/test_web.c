@@ -66,6 +66,12 @@
  *                 closed; "flat"'s children in pages of 512 (offset 11,776: the last 224), every
  *                 child once over the 24 pages; a page past the end is empty; an unknown node and
  *                 a node or offset that is no whole number are refused
+ *   web_views     saved views: a server whose views' file holds view 2 lists it ("views"); a page
+ *                 saves the view as 5 (listed, written to the file with the camera's field of
+ *                 view), drags away, recalls 5 (the frame's eye within 1e-3 of the saved one, the
+ *                 same direction) and 2 (the file's eye and 30 degree field of view); an empty slot
+ *                 moves nothing; a read-only server recalls and refuses saves (no list, the file
+ *                 unchanged); an unreadable file is left as it is, saves kept by the server and said so
  *   web_frame     the binary frame (sy_web_frame.h) round-trips: header fields, the depth channel
  *                 (the grid of every second pixel) within its 16-bit log step, "nothing" kept; a
  *                 tilted plane codes to under a quarter of its grid's 2 bytes per value; a frame
@@ -81,8 +87,8 @@
  *
  * The parts live in test_web_http.c (page, still, routes, clientfiles), test_web_stream.c (stream,
  * progressive, frame, videostream, encodecost), test_web_guard.c (token, hostile, slowloris,
- * stillbudget) and test_web_scene.c (messages, scene, readonly, timeline); web_test.c holds what
- * they share (web_test.h). */
+ * stillbudget), test_web_scene.c (messages, scene, readonly, timeline) and test_web_views.c (views);
+ * web_test.c holds what they share (web_test.h). */
 #include "web_test.h"
 
 int main(int argc, char **argv)
@@ -99,7 +105,7 @@ int main(int argc, char **argv)
         int (*run)(void);
     } alone[] = {{"messages", test_messages},   {"timeline", test_timeline},       {"frame", test_frame},
                  {"encodecost", test_encode_cost}, {"clientfiles", test_client_files}, {"token", test_token},
-                 {"progressive", test_progressive}};
+                 {"progressive", test_progressive}, {"views", test_views}};
     for (size_t i = 0; i < sizeof alone / sizeof alone[0]; ++i)
         if (!strcmp(which, alone[i].name)) {
             int f = alone[i].run();

@@ -55,8 +55,19 @@ int test_messages(void)
     CHECK(parse_ok("{\"t\":\"anim\",\"clip\":3}", &in) && in.type == SY_WEB_INPUT_ANIM && in.a == 3 &&
           !sy_web_input_changes_scene(&in));
     CHECK(parse_ok("{\"t\":\"anim\",\"clip\":-1}", &in) && in.a == -1);
+    /* saved views: a recall is the camera (a read-only page may), a save changes what every page shares */
+    CHECK(parse_ok("{\"t\":\"view\",\"n\":3}", &in) && in.type == SY_WEB_INPUT_VIEW && in.slot == 3 && !in.on &&
+          !sy_web_input_changes_scene(&in));
+    CHECK(parse_ok("{\"t\":\"view\",\"n\":9,\"save\":true,\"id\":4}", &in) && in.slot == 9 && in.on &&
+          sy_web_input_changes_scene(&in));
     const char *bad[] = {
-        "{\"t\":\"anim\"}",                            /* no clip */
+        "{\"t\":\"view\"}",                            /* no slot */
+        "{\"t\":\"view\",\"n\":0}",                  /* slots 1..9 */
+        "{\"t\":\"view\",\"n\":10}",
+        "{\"t\":\"view\",\"n\":2.5}",
+        "{\"t\":\"view\",\"n\":\"2\"}",
+        "{\"t\":\"view\",\"n\":2,\"save\":1}",
+                "{\"t\":\"anim\"}",                            /* no clip */
         "{\"t\":\"anim\",\"clip\":-2}",              /* -1 is every clip, nothing below */
         "{\"t\":\"anim\",\"clip\":1.5}",
         "{\"t\":\"anim\",\"clip\":\"Walk\"}",      /* an index, not a name */

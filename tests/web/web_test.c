@@ -117,6 +117,7 @@ static sy_result route_block(void *user, sy_scene *scene, const sy_web_request *
 
 /* the demo scene served on listen by backend from a thread of its own; 1 after printing why not */
 bool web_read_only; /* web_readonly: the server web_start() makes is read-only */
+const char *web_bookmarks; /* web_views: its saved views' file */
 bool web_read_only_anim; /* web_timeline: the demo gets two clips (shrink, hold), the server plays shrink */
 
 /* Two clips on the same nodes, as a character's walk and run (the Fox's): "shrink", each node of
@@ -196,7 +197,7 @@ int web_start(server *s, const char *listen, const char *backend, sy_error *e)
                                               {"GET", "/api/block", route_block, NULL}};
         sy_web_desc d = {.scene = s->scene, .root = demo.root, .camera = demo.camera, .background = demo.background,
                          .backend = backend, .listen = listen, .max_body = 1000, .max_message = 256, .max_clients = 3,
-                         .routes = routes, .route_count = 3, .read_only = web_read_only,
+                         .routes = routes, .route_count = 3, .read_only = web_read_only, .bookmarks = web_bookmarks,
                          .still_max_pixels = 20000, /* small stills: fast on a loaded machine */
                          .clip = shrink}; /* web_timeline: the server's clock plays shrink alone */
         failed = sy_web_create(&d, &s->web, e) != SY_OK;

@@ -68,6 +68,8 @@ typedef struct server {
 } server;
 /* web_readonly, web_timeline: the server web_start() makes is read-only. */
 extern bool web_read_only;
+/* web_views: the saved views' file of the server web_start() makes (NULL: none). */
+extern const char *web_bookmarks;
 /* web_timeline: the demo gets a clip "shrink" (every mesh node's scale to 1 % over 2 s). */
 extern bool web_read_only_anim;
 /* web_tree: the demo's root gets a group "flat" of 12,000 children and a group "deep" of 20 groups
@@ -114,6 +116,8 @@ int test_still_budget(server *s, uint16_t port);
 int test_messages(void);
 int test_scene(uint16_t port);
 int test_timeline(void);
+/* test_web_views.c */
+int test_views(void);
 /* a viewer of a server web_start_viewer() started (test_web.c sets web_read_only, web_big_tree) */
 int test_readonly(sy_web_client *c);
 int test_tree(sy_web_client *c);

@@ -2,7 +2,7 @@
 // panel and its menu (back-end, display filter, exposure, environment), the help overlay (? key and button), the
 // screenshot button (the still route at the canvas' size, downloaded) and the stats panel
 // (window.sy.stats()). A read-only server (sy web --read-only) hides what it would refuse.
-// tree.js, measure.js, section.js and touch.js add their parts to the panel through window.sy.ui.
+// views.js, tree.js, measure.js, section.js and touch.js add their parts to the panel through window.sy.ui.
 "use strict";
 (function () {
   const sy = window.sy, canvas = document.getElementById("sy-canvas");
@@ -111,10 +111,12 @@
     ["Touch", ""], ["one finger", "orbit"], ["two fingers", "pan (move together) and zoom (pinch)"], ["tap", "pick"],
     ["Keys", ""], ["1 - 9", "the back-end at that position of the menu"], ["F", "next display filter"],
     ["[ and ]", "halve / double the filter's threshold"], ["R", "back to the first view"],
+    ["Shift + 1 - 9", "recall saved view N (the panel's Saved views; every page shares them)"],
+    ["Ctrl + Shift + 1 - 9", "save the view now as N (the server keeps them in the scene's .bookmarks file, as sy view)"],
     ["M", "measure: click two points, their distance in scene units"], ["Esc", "leave measuring (the points go); close this help"],
     ["?", "this help"], ["space", "play / pause the scene (when it moves: the timeline at the bottom scrubs it)"],
     ["Panel", ""], ["☰", "show / hide the panel"], ["Screenshot", "downloads a JPEG of the view at the canvas' size"],
-    ["Measure", "click two points: their distance"], ["tree", "the check box shows / hides a node, a click on its name selects it"],
+    ["Measure", "click two points: their distance"], ["Saved views", "a number recalls that view, Save as keeps the view now"], ["tree", "the check box shows / hides a node, a click on its name selects it"],
     ["section planes", "up to 6 cuts along X, Y or Z, each with a slider across the scene and a flip; Cap fills the cut faces in a colour"],
     ["environment", "the menu's light from outside the scene: the scene's own, a studio, none"]];
   const tb = el("table", {}, hb);
@@ -123,8 +125,8 @@
     const tr = el("tr", {}, tb);
     el("td", {}, tr, k); el("td", {}, tr, v);
   }
-  el("p", { class: "note" }, hb, "A read-only server (sy web --read-only) lets you move the camera and the scene clock, pick and take " +
-     "screenshots; visibility, selection, section planes, exposure, filter and back-end stay as they are.");
+  el("p", { class: "note" }, hb, "A read-only server (sy web --read-only) lets you move the camera and the scene clock, recall saved views, pick and take " +
+     "screenshots; the saved views, visibility, selection, section planes, exposure, filter and back-end stay as they are.");
   function toggleHelp(on) { help.classList.toggle("sy-hidden", on === undefined ? undefined : !on); ui.helpOpen = !help.classList.contains("sy-hidden"); }
   ui.toggleHelp = toggleHelp;
   help.addEventListener("click", function () { toggleHelp(false); });

@@ -543,10 +543,12 @@
   const listeners = []; // window.sy.on: the server's text messages, parsed
   let lastHello = null;
   // the server's text messages while the page loads: until index.html's "sy-scripts-loaded", which
-  // comes after every one of the page's scripts ran
+  // comes after every one of the page's scripts ran (or the window's load, should a script fail)
   const early = [];
   let pageLoading = !(window.syEarly && window.syEarly.scriptsLoaded);
-  document.addEventListener("sy-scripts-loaded", function () { pageLoading = false; early.length = 0; });
+  function loaded() { pageLoading = false; early.length = 0; }
+  document.addEventListener("sy-scripts-loaded", loaded);
+  window.addEventListener("load", loaded); // (after it too: scripts inserted while the page loads hold its load event)
   function send(o) {
     if (ws && ws.readyState === 1) ws.send(JSON.stringify(o));
   }
@@ -639,6 +641,7 @@
   }, { passive: false });
   window.addEventListener("keydown", function (e) {
     if (e.target && /^(INPUT|SELECT|TEXTAREA)$/.test(e.target.tagName)) return; // typing in the panel
+    if (e.ctrlKey || e.altKey || e.metaKey) return; // the browser's keys (Ctrl+R, Ctrl+1..9), views.js's
     const k = e.key.length === 1 ? e.key.toLowerCase() : "";
     if (/^[1-9f\[\]r]$/.test(k)) input({ t: "key", k: k }, e);
   });
