@@ -52,7 +52,7 @@
                     (v.fov ? ", " + v.fov.toFixed(1) + "° field of view" : "") : "no view saved in " + n;
     }
     note.textContent = (ui.views.list.length ? ui.views.list.length + " saved" : "no saved views yet") +
-                       (ui.views.kept ? ", kept in the scene's .bookmarks file" : ", kept by the server while it runs") +
+                       (ui.views.kept ? ", kept in the server's views file (.bookmarks)" : ", kept by the server while it runs") +
                        (ui.views.note ? " (" + ui.views.note + ")" : "");
   });
 })();
