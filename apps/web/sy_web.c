@@ -185,7 +185,8 @@ sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err)
         sodium_memzero(raw, sizeof raw);
     }
     /* the view every page shares starts at the camera's pose; it is set on the server's viewports,
-     * never in the scene (sy_interactive.h): the server adds nothing to the scene, commits nothing */
+     * never in the scene (sy_interactive.h): the server adds nothing to the scene (a recalled saved
+     * view's field of view is set on the camera: sy_web_views.c) */
     if (r == SY_OK && (r = sy_interactive_input_init(desc->scene, desc->root, desc->camera, 1.0f, desc->filter,
                                                      desc->threshold > 0 ? desc->threshold : 0.0f, &w->in, err)))
         sy_error_prefix(err, "web");
