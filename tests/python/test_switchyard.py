@@ -325,6 +325,28 @@ def test_serve_plays_the_clip_given(tmp_path):
         switchyard.serve("demo", port=0, clip=0)
 
 
+def test_serve_keeps_the_saved_views_file(tmp_path):
+    """serve(..., bookmarks=FILE) is sy web --bookmarks: the views sy view saved in FILE are listed
+    to every page ("views"); without it the server keeps the pages' views itself; a file that is no
+    views' file is left as it is (the list says why)."""
+    if not hasattr(switchyard._c, "_Web"):
+        pytest.skip("built without the web view (SY_WITH_WEB)")
+    marks = tmp_path / "demo.bookmarks"
+    marks.write_text("# sy bookmarks\n4 3 2 4 0 0.5 0 0 1 0 35\n")
+    with switchyard.serve("demo", port=0, backend=NAMES[0], bookmarks=marks) as srv:
+        views = _ws_message(srv.port, "views")
+        assert views["kept"] and [v["n"] for v in views["views"]] == [4], views
+        assert views["views"][0]["eye"] == [3, 2, 4] and abs(views["views"][0]["fov"] - 35) < 1e-4, views
+    with switchyard.serve("demo", port=0, backend=NAMES[0]) as srv:
+        views = _ws_message(srv.port, "views")
+        assert not views["kept"] and views["views"] == [], views
+    marks.write_text("4 not a view\n")
+    with switchyard.serve("demo", port=0, backend=NAMES[0], bookmarks=str(marks)) as srv:
+        views = _ws_message(srv.port, "views")
+        assert not views["kept"] and "could not be read" in views["note"], views
+    assert marks.read_text() == "4 not a view\n"
+
+
 @needs_whitted
 def test_default_clip_is_sy_renders(tmp_path):
     """Without clip=, load(at=) and Scene.set_time play the clip sy render plays without --clip (two

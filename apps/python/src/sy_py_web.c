@@ -50,21 +50,22 @@ static void web_dealloc(PyObject *self)
 }
 
 /* _Web(scene, backend=None, listen=None, token=None, max_width=0, max_height=0, quality=0,
- * filter=None, threshold=0, budget_ms=0, clip=None): serving starts at once; clip (a name or an
- * index, as sy web --clip: sy_animation_find) is the clip the timeline plays (None: as sy web
- * without --clip, sy_cli_default_clip) */
+ * filter=None, threshold=0, budget_ms=0, clip=None, bookmarks=None): serving starts at once; clip
+ * (a name or an index, as sy web --clip: sy_animation_find) is the clip the timeline plays (None:
+ * as sy web without --clip, sy_cli_default_clip); bookmarks: the saved views' file (sy web
+ * --bookmarks; None: the server keeps the pages' views while it runs) */
 static PyObject *web_new(PyTypeObject *type, PyObject *args, PyObject *kw)
 {
     static char *kwlist[] = {"scene", "backend", "listen", "token", "max_width", "max_height", "quality", "filter",
-                             "threshold", "budget_ms", "clip", NULL};
+                             "threshold", "budget_ms", "clip", "bookmarks", NULL};
     PyObject *scene;
-    const char *backend = NULL, *listen = NULL, *token = NULL, *filter = NULL, *clip = NULL;
+    const char *backend = NULL, *listen = NULL, *token = NULL, *filter = NULL, *clip = NULL, *bookmarks = NULL;
     unsigned int mw = 0, mh = 0;
     int quality = 0;
     float threshold = 0.0f;
     double budget = 0.0;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "O!|zzzIIizfdz", kwlist, sy_py_scene_type, &scene, &backend, &listen, &token,
-                                     &mw, &mh, &quality, &filter, &threshold, &budget, &clip))
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O!|zzzIIizfdzz", kwlist, sy_py_scene_type, &scene, &backend, &listen, &token,
+                                     &mw, &mh, &quality, &filter, &threshold, &budget, &clip, &bookmarks))
         return NULL;
     SceneObject *s = (SceneObject *)scene;
     sy_scene *sc = sy_py_scene_use(s);
@@ -87,7 +88,8 @@ static PyObject *web_new(PyTypeObject *type, PyObject *args, PyObject *kw)
     if (!w) return NULL;
     sy_web_desc d = {.scene = sc, .root = s->ld.root, .camera = s->ld.camera, .background = s->ld.background,
                      .backend = backend, .listen = listen, .token = token, .max_width = mw, .max_height = mh,
-                     .quality = quality, .filter = filter, .threshold = threshold, .budget_ms = budget, .clip = played};
+                     .quality = quality, .filter = filter, .threshold = threshold, .budget_ms = budget, .clip = played,
+                     .bookmarks = bookmarks};
     s->busy = 1; /* from here the scene belongs to the server (released in web_stop) */
     Py_BEGIN_ALLOW_THREADS
     r = sy_web_create(&d, &w->web, &err);

@@ -599,7 +599,7 @@ class Server(_Closing):
 
 
 def serve(scene, port=8080, host="127.0.0.1", backend=None, token=None, width=1920, height=1200, quality=80,
-          filter=None, threshold=0.0, budget_ms=0.0, clip=None, **load_options):
+          filter=None, threshold=0.0, budget_ms=0.0, clip=None, bookmarks=None, **load_options):
     """Serves the web view of a Scene or a file (loaded with load_options) as ``sy web`` does
     (docs/WEB.md): an HTTP + WebSocket server whose page shows ``backend``'s view of the scene,
     streamed as JPEG and steered by the page; stills at ``/api/frame.jpg?w=W&h=H``. Returns a
@@ -613,7 +613,9 @@ def serve(scene, port=8080, host="127.0.0.1", backend=None, token=None, width=19
     filter of a back-end with filters; budget_ms: the frame-time budget while the view moves (0:
     33 ms); clip: the clip the page's timeline plays, a name or an index (sy web's --clip; an unknown
     one raises NotFoundError naming the clips; None: every clip together; the page may choose
-    another)."""
+    another); bookmarks: the file of the saved views every page shares (sy web's --bookmarks, the
+    format sy view keeps; read at start, rewritten on each save; None: the server keeps them while
+    it runs; docs/WEB.md, "Saved views")."""
     owns = not isinstance(scene, Scene)
     if owns:
         scene = load(scene, **load_options)
@@ -627,7 +629,7 @@ def serve(scene, port=8080, host="127.0.0.1", backend=None, token=None, width=19
     listen = "[%s]:%d" % (host, port) if ":" in host else "%s:%d" % (host, port)
     try:
         impl = _c._Web(scene._c, backend, listen, token, width, height, quality, filter, threshold, budget_ms,
-                       None if clip is None else str(clip))
+                       None if clip is None else str(clip), None if bookmarks is None else str(bookmarks))
     except BaseException:
         if owns:
             scene.close()

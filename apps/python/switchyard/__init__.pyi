@@ -211,6 +211,7 @@ class Server:
 def serve(scene: Union[str, Scene], port: int = ..., host: str = ..., backend: Optional[str] = ...,
           token: Optional[str] = ..., width: int = ..., height: int = ..., quality: int = ...,
           filter: Optional[str] = ..., threshold: float = ..., budget_ms: float = ...,
+          clip: Union[str, int, None] = ..., bookmarks: Optional[str] = ...,
           **load_options: Any) -> Server: ...
 
 class Viewport:
