@@ -226,8 +226,8 @@ sy_result sy_webi_views_init(sy_web *w, const sy_web_desc *desc, sy_error *err);
 typedef enum web_view_done { WEB_VIEW_NONE, WEB_VIEW_RECALLED, WEB_VIEW_SAVED } web_view_done;
 /* Network thread, mu held: a recall sets the shared orbit (and fov_req when the view was saved
  * with another field of view): RECALLED, an input the next frames answer; a save puts the view now
- * in its slot: SAVED, the caller releases mu and calls sy_webi_views_write; an empty slot is
- * logged: NONE. */
+ * in its slot: SAVED, the caller releases mu and calls sy_webi_views_write (the view the slot
+ * holds already: NONE, nothing written); an empty slot is logged: NONE. */
 web_view_done sy_webi_view_message(sy_web *w, const sy_web_input *in, const char *peer);
 /* Network thread, mu not held: the views rewritten to their file (a failure: logged and told to
  * the pages in the list's "note"), then views_version bumped (the caller tells every page). */

@@ -33,6 +33,12 @@ sy_result sy_webi_views_init(sy_web *w, const sy_web_desc *desc, sy_error *err)
     return SY_OK;
 }
 
+static bool same_view(const sy_bookmark *a, const sy_bookmark *b)
+{
+    return a->set && b->set && !memcmp(a->eye, b->eye, sizeof a->eye) && !memcmp(a->target, b->target, sizeof a->target) &&
+           !memcmp(a->up, b->up, sizeof a->up) && a->fov == b->fov;
+}
+
 web_view_done sy_webi_view_message(sy_web *w, const sy_web_input *in, const char *peer)
 {
     sy_bookmark *b = &w->marks[in->slot];
@@ -44,6 +50,7 @@ web_view_done sy_webi_view_message(sy_web *w, const sy_web_input *in, const char
             sy_log(SY_LOG_WARNING, "web", peer, "view %u not saved: %s", in->slot, e.message);
             return WEB_VIEW_NONE;
         }
+        if (same_view(b, &v)) return WEB_VIEW_NONE; /* the same view again: no write (a page that repeats saves costs nothing) */
         *b = v;
         return WEB_VIEW_SAVED;
     }

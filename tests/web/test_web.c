@@ -68,7 +68,7 @@
  *                 a node or offset that is no whole number are refused
  *   web_views     saved views: a server whose views' file holds view 2 lists it ("views"); a page
  *                 saves the view as 5 (listed, written to the file with the camera's field of
- *                 view), drags away, recalls 5 (the frame's eye within 1e-3 of the saved one, the
+ *                 view; the same again sends nothing), drags away, recalls 5 (the frame's eye within 1e-3 of the saved one, the
  *                 same direction) and 2 (the file's eye and 30 degree field of view); an empty slot
  *                 moves nothing; a read-only server recalls and refuses saves (no list, the file
  *                 unchanged); an unreadable file is left as it is, saves kept by the server and said so

@@ -1,8 +1,8 @@
 /* test_web_views.c — test_web's saved-views part (web_views; test_web.c lists what each part checks):
- * a server whose views' file holds one view, a page saving the shared view, moving, recalling it
- * and the file's view (the frames' cameras and field of view as saved), an empty slot recalled
- * (nothing moves), a read-only server (recalls, refuses saves), and an unreadable file (left as it
- * is, views kept by the server). */
+ * a server whose views' file holds one view, a page saving the shared view (the same again: nothing
+ * sent), moving, recalling it and the file's view (the frames' cameras and field of view as
+ * saved), an empty slot recalled (nothing moves), a read-only server (recalls, refuses saves), and
+ * an unreadable file (left as it is, views kept by the server). */
 #include "web_test.h"
 
 #include "sy_bookmarks.h"
@@ -111,6 +111,12 @@ int test_views(void)
               fabsf(got[5].fov - frame_fov(&f0)) < 1e-5f);
     }
     cJSON_Delete(l), l = NULL;
+    /* the same view saved again: nothing written, no list (a page repeating saves costs nothing) */
+    if (!failed) {
+        char *t = NULL;
+        CHECK(send_text(c, "{\"t\":\"view\",\"n\":5,\"save\":true}") == 0);
+        CHECK(sy_web_client_next_text(c, 500, "views", &t, &err) == SY_ERR_IO);
+    }
     /* moved away, then view 5 recalled: the frame's camera is where it was saved */
     failed = failed || send_text(c, "{\"t\":\"drag\",\"dx\":60,\"dy\":25,\"id\":1}") || frame_for(c, 1, &fi);
     if (!failed) {
