@@ -124,6 +124,26 @@ bool sy_interactive_key(sy_interactive_input *in, int key)
     return true;
 }
 
+float sy_interactive_fov(const sy_scene *scene, sy_node camera)
+{
+    const sy_node_data *cn = camera.id ? sy_node_get(scene, camera) : NULL;
+    const sy_camera_data *cd = cn && cn->camera.id ? sy_camera_get(scene, cn->camera) : NULL;
+    return cd && cd->projection == SY_PROJECTION_PERSPECTIVE ? cd->yfov : 0.0f;
+}
+
+sy_result sy_interactive_set_fov(sy_scene *scene, sy_node camera, float fov, sy_error *err)
+{
+    const sy_node_data *cn = camera.id ? sy_node_get(scene, camera) : NULL;
+    const sy_camera_data *cd = cn && cn->camera.id ? sy_camera_get(scene, cn->camera) : NULL;
+    if (!cd) return sy_error_set(err, SY_ERR_NOT_FOUND, "field of view: node %u has no camera", camera.id);
+    sy_camera_data nd = *cd;
+    char *name = cd->name ? strdup(cd->name) : NULL; /* the scene's copy is replaced by the set */
+    nd.yfov = fov, nd.name = name;
+    sy_result r = sy_camera_set(scene, cn->camera, &nd, err);
+    free(name);
+    return r == SY_OK ? sy_scene_commit(scene, NULL, err) : r;
+}
+
 sy_result sy_interactive_backend_index(const char *name, uint32_t *index, sy_error *err)
 {
     const sy_mediator_class *c = name ? sy_mediator_find(name) : sy_mediator_default();

@@ -71,6 +71,14 @@ const char *sy_interactive_filter_name(uint32_t index, char out[32]);
  * sy_mediator_default); SY_ERR_NOT_FOUND when it is not registered. */
 sy_result sy_interactive_backend_index(const char *name, uint32_t *index, sy_error *err);
 
+/** The vertical field of view (radians) of camera node camera's camera: what a saved view keeps
+ * (sy_bookmarks.h); 0 for an orthographic camera or a node without one. */
+float sy_interactive_fov(const sy_scene *scene, sy_node camera);
+/** Sets fov (radians, in (0, pi)) as the camera's vertical field of view and commits the scene: a
+ * recalled saved view's (sy view, sy web). SY_ERR_NOT_FOUND when the node has no camera. Called
+ * by the thread that owns the scene. */
+sy_result sy_interactive_set_fov(sy_scene *scene, sy_node camera, float fov, sy_error *err);
+
 /* ---- the render side ---- */
 
 /** The render thread's state (opaque). */

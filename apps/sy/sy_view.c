@@ -421,17 +421,8 @@ static void *render_main(void *p)
         v->redraw = false, v->fov_req = 0.0f;
         pthread_mutex_unlock(&v->mu);
         if (fov_req > 0.0f) { /* a recalled view's field of view: the camera's, a scene change */
-            const sy_node_data *cnd = sy_node_get(a->scene, a->spec.camera);
-            const sy_camera_data *cd = cnd && cnd->camera.id ? sy_camera_get(a->scene, cnd->camera) : NULL;
-            if (cd) {
-                sy_camera_data nd = *cd;
-                char *name = cd->name ? strdup(cd->name) : NULL; /* the scene's copy is replaced by the set */
-                nd.yfov = fov_req, nd.name = name;
-                sy_result fr = sy_camera_set(a->scene, cnd->camera, &nd, &err);
-                free(name);
-                if (fr != SY_OK || sy_scene_commit(a->scene, NULL, &err) != SY_OK) goto fail_unlocked;
-                redraw = true;
-            }
+            if (sy_interactive_set_fov(a->scene, a->spec.camera, fov_req, &err) != SY_OK) goto fail_unlocked;
+            redraw = true;
         }
         bool time_moved = false;
         if (playing || steps) {
@@ -907,10 +898,7 @@ static sy_result view_run(const sy_view_args *args, sy_context_pool *pool, view_
         return sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "view: the scene has no camera");
     }
     v.in = in0;
-    {
-        const sy_camera_data *cd = sy_camera_get(args->scene, cn->camera);
-        v.fov = cd && cd->projection == SY_PROJECTION_PERSPECTIVE ? cd->yfov : 0.0f;
-    }
+    v.fov = sy_interactive_fov(args->scene, args->spec.camera);
     int fbw, fbh;
     glfwGetFramebufferSize(win, &fbw, &fbh);
     v.w = (uint32_t)fbw, v.h = (uint32_t)fbh;

@@ -5,7 +5,6 @@
  * saved field of view on the camera; the "views" message lists them for the pages. */
 #include "sy_web_internal.h"
 
-#include "sy_graph.h"
 #include "sy_log.h"
 
 #include <cjson/cJSON.h>
@@ -17,9 +16,7 @@
 
 sy_result sy_webi_views_init(sy_web *w, const sy_web_desc *desc, sy_error *err)
 {
-    const sy_node_data *cn = sy_node_get(desc->scene, desc->camera);
-    const sy_camera_data *cd = cn ? sy_camera_get(desc->scene, cn->camera) : NULL;
-    w->fov = cd && cd->projection == SY_PROJECTION_PERSPECTIVE ? cd->yfov : 0.0f;
+    w->fov = sy_interactive_fov(desc->scene, desc->camera);
     w->views_version = 1; /* every page is sent the list after its hello */
     if (!desc->bookmarks) return SY_OK;
     sy_error be = {0};
@@ -104,17 +101,8 @@ char *sy_webi_views_json(sy_web *w, uint64_t *sent)
 
 bool sy_webi_views_set_fov(sy_web *w, float fov)
 {
-    sy_scene *s = w->d.scene;
-    const sy_node_data *cn = sy_node_get(s, w->d.camera);
-    const sy_camera_data *cd = cn && cn->camera.id ? sy_camera_get(s, cn->camera) : NULL;
-    if (!cd) return false;
-    sy_camera_data nd = *cd;
-    char *name = cd->name ? strdup(cd->name) : NULL; /* the scene's copy is replaced by the set */
-    nd.yfov = fov, nd.name = name;
     sy_error e = {0};
-    sy_result r = sy_camera_set(s, cn->camera, &nd, &e);
-    free(name);
-    if (r == SY_OK) r = sy_scene_commit(s, NULL, &e);
+    sy_result r = sy_interactive_set_fov(w->d.scene, w->d.camera, fov, &e);
     if (r != SY_OK) sy_log(SY_LOG_WARNING, "web", NULL, "a saved view's field of view: %s", e.message);
     return r == SY_OK;
 }
