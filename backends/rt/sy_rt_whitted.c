@@ -88,6 +88,7 @@ typedef struct whitted_job {
     sy_rt_env env;
     bool area_analytic; /* emissive triangles integrated analytically (LTC) */
     struct apoly *poly; /* area_analytic: the emitters as planar polygons */
+    struct apoly_soa *pv; /* the same, structure of arrays (apoly_soa) */
     uint32_t n_poly;
     uint32_t spp;    /* camera rays per pixel */
     bool motion;     /* some instance or the camera moves over the shutter: each camera ray has its own time */
@@ -197,11 +198,6 @@ typedef struct amodel {
     float rough_c;
 } amodel;
 
-static sy_rt_v3 m3v(const float *m, sy_rt_v3 v)
-{
-    return v3(m[0] * v.x + m[1] * v.y + m[2] * v.z, m[3] * v.x + m[4] * v.y + m[5] * v.z, m[6] * v.x + m[7] * v.y + m[8] * v.z);
-}
-
 /* (T1, T2, n) rows with T1 in the plane of n and wo. */
 static void make_frame(sy_rt_v3 n, sy_rt_v3 wo, float fr[9])
 {
@@ -272,17 +268,6 @@ static bool amodel_init(amodel *m, const sy_rt_bsdf *b, sy_rt_v3 wo)
     return true;
 }
 
-/* Heitz et al. 2016, clipless: the cosine-weighted integral over the triangle (v: vertices
- * relative to the shading point) after the transform m, horizon-clipped through ltc2's sphere
- * term; both orientations count (the caller decides the emitting side). */
-static sy_rt_v3 edge_vec(sy_rt_v3 v1, sy_rt_v3 v2)
-{
-    float x = v3_dot(v1, v2), y = fabsf(x);
-    float a = 0.8543985f + (0.4965155f + 0.0145206f * y) * y, b = 3.4175940f + (4.1616724f + y) * y, v = a / b;
-    float ts = x > 0.0f ? v : 0.5f / sqrtf(fmaxf(1.0f - x * x, 1e-7f)) - v;
-    return v3_scale(v3_cross(v1, v2), ts);
-}
-
 /* An emitter for the closed form: one emissive triangle, or two coplanar ones sharing an edge with
  * the same emission merged into a quad (a rectangle light is one polygon: 4 edges, not 6). */
 typedef struct apoly {
@@ -346,81 +331,148 @@ static apoly *build_polys(const sy_rt_device *dev, uint32_t *count)
     return out;
 }
 
-/* Heitz et al. 2016, clipless: the cosine-weighted integral over the polygon (l: its unit vertex
- * directions in the lobe's cosine space, ctr: a point inside it, any length) as the vector form
- * factor; a polygon wholly above the horizon integrates to its z, one that crosses it is clipped
- * through ltc2's sphere term. Both orientations count (the caller decides the emitting side). */
-static float ltc_integral(const sy_rt_v3 *l, uint32_t nv, sy_rt_v3 ctr, bool above)
+/* The polygons as structure of arrays, for the closed form's vectorised loops (apoly_forms): four
+ * vertex slots each, a triangle's as (v0, v0, v1, v2), so that its edge sum starts with the zero
+ * edge and then adds the triangle's own edges in apoly's order (the same sums, bit for bit); its
+ * second slot stays out of the centre (quad 0). */
+typedef struct apoly_soa {
+    float x[4][ANALYTIC_MAX_TRIANGLES], y[4][ANALYTIC_MAX_TRIANGLES], z[4][ANALYTIC_MAX_TRIANGLES];
+    float quad[ANALYTIC_MAX_TRIANGLES]; /* 1: a quad, 0: a triangle */
+    float nx[ANALYTIC_MAX_TRIANGLES], ny[ANALYTIC_MAX_TRIANGLES], nz[ANALYTIC_MAX_TRIANGLES];
+    float scale[ANALYTIC_MAX_TRIANGLES];  /* its size, for the in-plane test */
+    float dsided[ANALYTIC_MAX_TRIANGLES]; /* 1: double-sided */
+} apoly_soa;
+
+static void apoly_soa_fill(apoly_soa *q, const apoly *poly, uint32_t n)
 {
-    sy_rt_v3 f = edge_vec(l[nv - 1u], l[0]);
-    for (uint32_t k = 0; k + 1u < nv; ++k) f = v3_add(f, edge_vec(l[k], l[k + 1u]));
-    if (v3_dot(f, ctr) < 0.0f) f = v3_scale(f, -1.0f);
-    if (above) return sy_rt_maxf(f.z, 0.0f);
-    float len = v3_length(f);
+    for (uint32_t i = 0; i < n; ++i) {
+        const apoly *p = &poly[i];
+        static const int tri_slot[4] = {0, 0, 1, 2};
+        for (int k = 0; k < 4; ++k) {
+            sy_rt_v3 v = p->v[p->nv == 4u ? k : tri_slot[k]];
+            q->x[k][i] = v.x, q->y[k][i] = v.y, q->z[k][i] = v.z;
+        }
+        q->quad[i] = p->nv == 4u ? 1.0f : 0.0f;
+        q->nx[i] = p->normal.x, q->ny[i] = p->normal.y, q->nz[i] = p->normal.z;
+        q->scale[i] = v3_max_abs(v3_sub(p->v[1], p->v[0])) + v3_max_abs(v3_sub(p->v[2], p->v[0]));
+        q->dsided[i] = p->double_sided ? 1.0f : 0.0f;
+    }
+}
+
+/* GCC: an AVX2 clone beside the default (the loops below run 8 polygons at a time); clang (the fuzz
+ * build) leaves a cloned static function's symbol undefined, so none there */
+#if defined(__clang__)
+#define SY_WHITTED_CLONES
+#else
+#define SY_WHITTED_CLONES __attribute__((target_clones("avx2", "default")))
+#endif
+
+/* edge_vec's scalar factor (x: the cosine between the edge's unit vertex directions), branch-free */
+static inline float edge_factor(float x)
+{
+    float y = fabsf(x);
+    float a = 0.8543985f + (0.4965155f + 0.0145206f * y) * y, b = 3.4175940f + (4.1616724f + y) * y, v = a / b;
+    float u = 1.0f - x * x;
+    u = u > 1e-7f ? u : 1e-7f;
+    return x > 0.0f ? v : 0.5f / sqrtf(u) - v;
+}
+
+/* One lobe's clipless integral over every polygon at once (apoly_forms' loops; the arithmetic of
+ * area_unshadowed and ltc_poly per lane). With m (a lobe's transform) the vertices relative to the
+ * shading point go through it and z is their third coordinate; without (the diffuse lobe) they stay
+ * in world space and z is along n. Per polygon: fz the form factor's z, flen its length, above 1
+ * where every vertex is above the horizon (then max(fz, 0) is the integral), below 1 where none is. */
+SY_WHITTED_CLONES
+static void lobe_forms(const apoly_soa *restrict q, uint32_t n, float px, float py, float pz, const float *m,
+                       float nx, float ny, float nz, float *restrict fz, float *restrict flen,
+                       float *restrict above, float *restrict below)
+{
+    const bool world = m == NULL; /* a select per lane below, not a branch: the loop stays vectorisable */
+    float m0 = world ? 1.0f : m[0], m1 = world ? 0.0f : m[1], m2 = world ? 0.0f : m[2];
+    float m3 = world ? 0.0f : m[3], m4 = world ? 1.0f : m[4], m5 = world ? 0.0f : m[5];
+    float m6 = world ? 0.0f : m[6], m7 = world ? 0.0f : m[7], m8 = world ? 1.0f : m[8];
+    for (uint32_t i = 0; i < n; ++i) {
+        float lx[4], ly[4], lz[4], cx = 0.0f, cy = 0.0f, cz = 0.0f, up = 1.0f, down = 1.0f;
+#pragma GCC unroll 4
+        for (int k = 0; k < 4; ++k) {
+            float vx = q->x[k][i] - px, vy = q->y[k][i] - py, vz = q->z[k][i] - pz;
+            float tx = m0 * vx + m1 * vy + m2 * vz, ty = m3 * vx + m4 * vy + m5 * vz, tz = m6 * vx + m7 * vy + m8 * vz;
+            float ax = world ? vx : tx, ay = world ? vy : ty, az = world ? vz : tz;
+            float zk = world ? vx * nx + vy * ny + vz * nz : tz;
+            float w = k == 1 ? q->quad[i] : 1.0f;
+            cx = cx + ax * w, cy = cy + ay * w, cz = cz + az * w;
+            up = zk >= 0.0f ? up : 0.0f;
+            down = zk <= 0.0f ? down : 0.0f;
+            float l2 = ax * ax + ay * ay + az * az, inv = l2 > 0.0f ? 1.0f / sqrtf(l2) : 0.0f;
+            lx[k] = ax * inv, ly[k] = ay * inv, lz[k] = az * inv;
+        }
+        float fx = 0.0f, fy = 0.0f, fzz = 0.0f;
+#pragma GCC unroll 4
+        for (int e = 0; e < 4; ++e) { /* edges (3, 0), (0, 1), (1, 2), (2, 3) */
+            int a0 = (e + 3) & 3, a1 = e;
+            float t = edge_factor(lx[a0] * lx[a1] + ly[a0] * ly[a1] + lz[a0] * lz[a1]);
+            float ex = (ly[a0] * lz[a1] - lz[a0] * ly[a1]) * t, ey = (lz[a0] * lx[a1] - lx[a0] * lz[a1]) * t,
+                  ez = (lx[a0] * ly[a1] - ly[a0] * lx[a1]) * t;
+            fx = e ? fx + ex : ex, fy = e ? fy + ey : ey, fzz = e ? fzz + ez : ez;
+        }
+        float flip = fx * cx + fy * cy + fzz * cz < 0.0f ? -1.0f : 1.0f;
+        fx *= flip, fy *= flip, fzz *= flip;
+        fz[i] = world ? fx * nx + fy * ny + fzz * nz : fzz;
+        flen[i] = sqrtf(fx * fx + fy * fy + fzz * fzz);
+        above[i] = up, below[i] = down;
+    }
+}
+
+/* Whether polygon i lights the shading point (px, py, pz) at all: not in its plane, and on its
+ * emitting side. */
+SY_WHITTED_CLONES
+static void poly_facing(const apoly_soa *restrict q, uint32_t n, float px, float py, float pz, float *restrict ok)
+{
+    for (uint32_t i = 0; i < n; ++i) {
+        float side = -((q->x[0][i] - px) * q->nx[i] + (q->y[0][i] - py) * q->ny[i] + (q->z[0][i] - pz) * q->nz[i]);
+        float as = fabsf(side);
+        ok[i] = as > 1e-6f * q->scale[i] + 1e-9f && (side >= 0.0f || q->dsided[i] > 0.0f) ? 1.0f : 0.0f;
+    }
+}
+
+/* A lobe's integral from lobe_forms' values: exact above the horizon, clipped through ltc2's
+ * sphere term otherwise. */
+static float lobe_value(float fz, float len, float above)
+{
+    if (above > 0.0f) return sy_rt_maxf(fz, 0.0f);
     if (!(len > 0.0f)) return 0.0f;
     float t[4];
-    ltc_fetch(g_ltc2, f.z / len * 0.5f + 0.5f, len, t);
+    ltc_fetch(g_ltc2, fz / len * 0.5f + 0.5f, len, t);
     return len * t[3];
 }
 
-/* The polygon v (relative to the shading point) through the lobe transform m. */
-static float ltc_poly(const float m[9], const sy_rt_v3 *v, uint32_t nv)
+/* Unshadowed light from every polygon at the shading point x (out[i]; 0 behind a one-sided emitter,
+ * in its plane or wholly under the horizon). The diffuse lobe is the cosine itself: its integral in
+ * world space (a rotation changes neither the edge vectors' lengths nor z = their sum . n). */
+static void area_unshadowed_all(const amodel *m, const apoly *poly, const apoly_soa *q, uint32_t n, sy_rt_v3 x,
+                                sy_rt_v3 *out)
 {
-    sy_rt_v3 l[4], ctr = v3(0.0f, 0.0f, 0.0f);
-    bool above = true;
-    for (uint32_t k = 0; k < nv; ++k) {
-        l[k] = m3v(m, v[k]);
-        ctr = v3_add(ctr, l[k]);
-        above = above && l[k].z >= 0.0f;
-        l[k] = v3_normalize(l[k]);
-    }
-    return ltc_integral(l, nv, ctr, above);
-}
-
-/* Unshadowed light from polygon p at the shading point x (0 behind a one-sided emitter or in its
- * plane). The diffuse lobe is the cosine itself: its integral in world space (a rotation changes
- * neither the edge vectors' lengths nor z = their sum . n). */
-static sy_rt_v3 area_unshadowed(const amodel *m, const apoly *p, sy_rt_v3 x)
-{
-    sy_rt_v3 v[4];
-    for (uint32_t k = 0; k < p->nv; ++k) v[k] = v3_sub(p->v[k], x);
-    float side = -v3_dot(v[0], p->normal); /* > 0: x on the front side */
-    float scale = v3_max_abs(v3_sub(p->v[1], p->v[0])) + v3_max_abs(v3_sub(p->v[2], p->v[0]));
-    if (!(fabsf(side) > 1e-6f * scale + 1e-9f) || (side < 0.0f && !p->double_sided)) return v3(0.0f, 0.0f, 0.0f);
-    sy_rt_v3 n = v3(m->frame[6], m->frame[7], m->frame[8]);
-    sy_rt_v3 l[4], ctr = v3(0.0f, 0.0f, 0.0f);
-    bool above = true, below = true;
-    for (uint32_t k = 0; k < p->nv; ++k) {
-        float z = v3_dot(v[k], n);
-        above = above && z >= 0.0f;
-        below = below && z <= 0.0f;
-        ctr = v3_add(ctr, v[k]);
-        l[k] = v3_normalize(v[k]);
-    }
-    if (below) return v3(0.0f, 0.0f, 0.0f); /* wholly under the shading point's horizon */
-    float fd;
-    {
-        sy_rt_v3 f = edge_vec(l[p->nv - 1u], l[0]);
-        for (uint32_t k = 0; k + 1u < p->nv; ++k) f = v3_add(f, edge_vec(l[k], l[k + 1u]));
-        if (v3_dot(f, ctr) < 0.0f) f = v3_scale(f, -1.0f);
-        float z = v3_dot(f, n);
-        if (above) fd = sy_rt_maxf(z, 0.0f);
-        else {
-            float len = v3_length(f), t[4];
-            fd = 0.0f;
-            if (len > 0.0f) {
-                ltc_fetch(g_ltc2, z / len * 0.5f + 0.5f, len, t);
-                fd = len * t[3];
-            }
+    float ok[ANALYTIC_MAX_TRIANGLES], fz[3][ANALYTIC_MAX_TRIANGLES], len[3][ANALYTIC_MAX_TRIANGLES];
+    float above[3][ANALYTIC_MAX_TRIANGLES], below[ANALYTIC_MAX_TRIANGLES], unused[ANALYTIC_MAX_TRIANGLES];
+    sy_rt_v3 nn = v3(m->frame[6], m->frame[7], m->frame[8]);
+    bool spec = !v3_is_zero(m->fl), coat = m->fc > 0.0f;
+    poly_facing(q, n, x.x, x.y, x.z, ok);
+    lobe_forms(q, n, x.x, x.y, x.z, NULL, nn.x, nn.y, nn.z, fz[0], len[0], above[0], below);
+    if (spec) lobe_forms(q, n, x.x, x.y, x.z, m->minv, 0.0f, 0.0f, 0.0f, fz[1], len[1], above[1], unused);
+    if (coat) lobe_forms(q, n, x.x, x.y, x.z, m->minv_c, 0.0f, 0.0f, 0.0f, fz[2], len[2], above[2], unused);
+    for (uint32_t i = 0; i < n; ++i) {
+        if (!(ok[i] > 0.0f) || below[i] > 0.0f) {
+            out[i] = v3(0.0f, 0.0f, 0.0f);
+            continue;
         }
+        sy_rt_v3 w = v3_scale(m->kd, lobe_value(fz[0][i], len[0][i], above[0][i]));
+        if (spec) w = v3_add(w, v3_scale(m->fl, lobe_value(fz[1][i], len[1][i], above[1][i])));
+        if (coat) {
+            float c = m->fc * lobe_value(fz[2][i], len[2][i], above[2][i]);
+            w = v3_add(w, v3(c, c, c));
+        }
+        out[i] = v3_mul(w, poly[i].emission);
     }
-    sy_rt_v3 w = v3_scale(m->kd, fd);
-    if (!v3_is_zero(m->fl)) w = v3_add(w, v3_scale(m->fl, ltc_poly(m->minv, v, p->nv)));
-    if (m->fc > 0.0f) {
-        float c = m->fc * ltc_poly(m->minv_c, v, p->nv);
-        w = v3_add(w, v3(c, c, c));
-    }
-    return v3_mul(w, p->emission);
 }
 
 /* Unshadowed light from the environment: split sum over the prefiltered maps. */
@@ -604,10 +656,11 @@ static sy_rt_v3 direct_area_analytic(trace_ctx *c, const sy_rt_surface *s, const
         if (!cam) cdf = local;
         a = v3(0.0f, 0.0f, 0.0f);
         cdf[0] = 0.0f;
+        sy_rt_v3 ai[ANALYTIC_MAX_TRIANGLES];
+        area_unshadowed_all(m, poly, c->job->pv, nt, s->p, ai);
         for (uint32_t i = 0; i < nt; ++i) {
-            sy_rt_v3 ai = area_unshadowed(m, &poly[i], s->p);
-            a = v3_add(a, ai);
-            cdf[i + 1u] = cdf[i] + sy_rt_maxf(v3_luminance(ai), 0.0f);
+            a = v3_add(a, ai[i]);
+            cdf[i + 1u] = cdf[i] + sy_rt_maxf(v3_luminance(ai[i]), 0.0f);
         }
         if (cam) {
             c->cache.valid = true, c->cache.inst = s->inst, c->cache.p = s->p, c->cache.n = b->n, c->cache.a = a;
@@ -1092,12 +1145,17 @@ sy_rt_result sy_rt_whitted_render(const sy_rt_frame *f, const sy_rt_render_desc 
     for (uint32_t i = 0; j->area_analytic && i < dev->area_count; ++i)
         if (dev->area[i].textured || dev->area[i].inst->motion || dev->area[i].inst->mesh->motion) j->area_analytic = false;
     j->poly = NULL;
+    j->pv = NULL;
     j->n_poly = 0;
-    if (j->area_analytic && !(j->poly = build_polys(dev, &j->n_poly))) {
+    if (j->area_analytic &&
+        (!(j->poly = build_polys(dev, &j->n_poly)) || !(j->pv = malloc(sizeof *j->pv)))) {
+        free(j->poly);
         free(j);
         return sy_rt_fail(dev, SY_RT_ERROR_OUT_OF_MEMORY, "render: out of memory");
     }
+    if (j->pv) apoly_soa_fill(j->pv, j->poly, j->n_poly);
     sy_rt_result r = sy_rt_run_tiles(f, whitted_tile, j, desc->progress, desc->progress_user_data);
+    free(j->pv);
     free(j->poly);
     free(j);
     return r;
