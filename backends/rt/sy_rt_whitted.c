@@ -331,7 +331,7 @@ static apoly *build_polys(const sy_rt_device *dev, uint32_t *count)
     return out;
 }
 
-/* The polygons as structure of arrays, for the closed form's vectorised loops (apoly_forms): four
+/* The polygons as structure of arrays, for the closed form's vectorised loops (lobe_forms): four
  * vertex slots each, a triangle's as (v0, v0, v1, v2), so that its edge sum starts with the zero
  * edge and then adds the triangle's own edges in apoly's order (the same sums, bit for bit); its
  * second slot stays out of the centre (quad 0). */
@@ -367,7 +367,8 @@ static void apoly_soa_fill(apoly_soa *q, const apoly *poly, uint32_t n)
 #define SY_WHITTED_CLONES __attribute__((target_clones("avx2", "default")))
 #endif
 
-/* edge_vec's scalar factor (x: the cosine between the edge's unit vertex directions), branch-free */
+/* The factor of an edge's cross product in the vector form factor (x: the cosine between the
+ * edge's unit vertex directions; the fitted acos(x) / sin(acos(x)) of Heitz et al. 2016), branch-free */
 static inline float edge_factor(float x)
 {
     float y = fabsf(x);
@@ -377,11 +378,13 @@ static inline float edge_factor(float x)
     return x > 0.0f ? v : 0.5f / sqrtf(u) - v;
 }
 
-/* One lobe's clipless integral over every polygon at once (apoly_forms' loops; the arithmetic of
- * area_unshadowed and ltc_poly per lane). With m (a lobe's transform) the vertices relative to the
- * shading point go through it and z is their third coordinate; without (the diffuse lobe) they stay
- * in world space and z is along n. Per polygon: fz the form factor's z, flen its length, above 1
- * where every vertex is above the horizon (then max(fz, 0) is the integral), below 1 where none is. */
+/* One lobe's integral over every polygon at once, lane by lane (Heitz et al. 2016, clipless: the
+ * vector form factor of the polygon's unit vertex directions, oriented towards its centre; both
+ * sides count, the caller decides the emitting one). With m (a lobe's transform) the vertices
+ * relative to the shading point go through it and z is their third coordinate; without (the
+ * diffuse lobe) they stay in world space and z is along n. Per polygon: fz the form factor's z,
+ * flen its length, above 1 where every vertex is above the horizon (then max(fz, 0) is the
+ * integral; else lobe_value clips through ltc2's sphere term), below 1 where none is. */
 SY_WHITTED_CLONES
 static void lobe_forms(const apoly_soa *restrict q, uint32_t n, float px, float py, float pz, const float *m,
                        float nx, float ny, float nz, float *restrict fz, float *restrict flen,
