@@ -355,22 +355,29 @@ static void test_alpha_mask_and_texture(void)
 }
 
 
-/* The analytic area light (sy_rt_whitted.c >>analytic): an unoccluded Lambert floor under a
- * square emitter gets the form factor at every pixel, whatever the number of samples: with one
- * sample per pixel the image equals the 256-sample one to float rounding (the visibility ratio of
- * unshadowed samples is exactly 1), and every pixel is within 0.3 % of the exact irradiance at its
- * floor point. Before the closed form, one sample per pixel missed by up to 60 %. */
-static void test_area_light_analytic(void)
+/* The analytic area light (sy_rt_whitted.c >>analytic): an unoccluded Lambert floor under an
+ * emitter gets the form factor at every pixel, whatever the number of samples: with one sample per
+ * pixel the image equals the 256-sample one to float rounding (the visibility ratio of unshadowed
+ * samples is exactly 1), and every pixel is within 0.3 % of the exact irradiance at its floor
+ * point. Before the closed form, one sample per pixel missed by up to 60 %. */
+#define AN_ALBEDO 0.8f
+#define AN_LE 3.0f
+
+/* A device with the Lambert floor (z = 0) the analytic checks light. */
+static sy_rt_device *analytic_floor(void)
 {
     sy_rt_device *dev = rt_device();
-    float xf[16], em[16];
-    rt_identity(xf);
-    const float albedo = 0.8f, le = 3.0f;
-    rt_place(dev, rt_quad(dev, 10.0f), xf, rt_lambert(dev, albedo, albedo, albedo), 0);
-    rt_rot_y(em, (float)M_PI, 0.0f, 0.0f, 1.0f);
-    rt_place(dev, rt_quad(dev, 0.5f), em, rt_emitter(dev, le, le, le), 0);
-    MUST(sy_rt_commit(dev));
-    sy_rt_camera cam = rt_camera(0.5f, TAN); /* sees the floor under the emitter, x, y in [-0.25, 0.25] */
+    rt_place(dev, rt_quad(dev, 10.0f), NULL, rt_lambert(dev, AN_ALBEDO, AN_ALBEDO, AN_ALBEDO), 0);
+    return dev;
+}
+
+/* Renders dev (analytic_floor and an emitter of radiance AN_LE, committed) from z = 0.5 looking
+ * down (the floor under the emitter, x, y in [-0.25, 0.25]) with one and 256 area-light samples;
+ * checks every pixel against the form factor of the emitter at its floor point, and the renders
+ * against each other. Destroys dev. */
+static void analytic_check(sy_rt_device *dev, double (*form_factor)(double x, double y), const char *what)
+{
+    sy_rt_camera cam = rt_camera(0.5f, TAN);
     sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, W, W);
     float *one, *many, *depth;
     rd.area_light_samples = 1;
@@ -383,83 +390,73 @@ static void test_area_light_analytic(void)
         for (int px = 0; px < W; ++px) {
             double x, y;
             pixel_point(px, py, 0.5f, &x, &y);
-            /* the exact irradiance: the square [-0.5, 0.5]^2 at height 1 as four corner rectangles */
-            double e = 0.0;
-            for (int q = 0; q < 4; ++q) {
-                double a = q & 1 ? 0.5 - x : 0.5 + x, b = q & 2 ? 0.5 - y : 0.5 + y, X = a, Y = b;
-                e += 1.0 / (2.0 * M_PI) * (X / sqrt(1 + X * X) * atan(Y / sqrt(1 + X * X)) + Y / sqrt(1 + Y * Y) * atan(X / sqrt(1 + Y * Y)));
-            }
-            double expect = albedo / M_PI * M_PI * le * e;
+            double expect = AN_ALBEDO * AN_LE * form_factor(x, y); /* albedo / pi x pi le F */
             const float *c1 = px_at(one, px, py), *cn = px_at(many, px, py);
             double r1 = fabs(c1[0] / expect - 1.0), rn = fabs(c1[0] / cn[0] - 1.0);
             if (r1 > worst) worst = r1;
             if (rn > worst_n) worst_n = rn;
         }
-    printf("analytic area light: worst pixel %.4f %% from the form factor (1 sample), %.2g from 256 samples\n", 100.0 * worst,
-           worst_n);
-    EXPECT_MSG(worst < 0.003, "analytic area light: a pixel %.4f %% from the exact irradiance", 100.0 * worst);
-    EXPECT_MSG(worst_n < 1e-5, "analytic area light: 1 and 256 samples differ by %.3g", worst_n);
+    printf("analytic %s: worst pixel %.4f %% from the form factor (1 sample), %.2g from 256 samples\n", what,
+           100.0 * worst, worst_n);
+    EXPECT_MSG(worst < 0.003, "analytic %s: a pixel %.4f %% from the exact irradiance", what, 100.0 * worst);
+    EXPECT_MSG(worst_n < 1e-5, "analytic %s: 1 and 256 samples differ by %.3g", what, worst_n);
     free(one);
     rt_image_free(many, depth);
     sy_rt_device_destroy(dev);
 }
 
+/* The square [-0.5, 0.5]^2 at height 1 from the floor point (x, y): four corner rectangles. */
+static double square_form_factor(double x, double y)
+{
+    double e = 0.0;
+    for (int q = 0; q < 4; ++q) {
+        double X = q & 1 ? 0.5 - x : 0.5 + x, Y = q & 2 ? 0.5 - y : 0.5 + y;
+        e += 1.0 / (2.0 * M_PI) * (X / sqrt(1 + X * X) * atan(Y / sqrt(1 + X * X)) + Y / sqrt(1 + Y * Y) * atan(X / sqrt(1 + Y * Y)));
+    }
+    return e;
+}
 
-/* The analytic area light for a lone triangle (a polygon of three vertices: the closed form's
- * loops take it as four slots, v0 twice): a Lambert floor under a downward-facing triangle gets
- * Lambert's polygon form factor, F = 1/(2 pi) sum over edges of theta_i (n . gamma_i), at every
- * pixel with one sample, and 1 and 256 samples agree to float rounding. */
+static void test_area_light_analytic(void)
+{
+    sy_rt_device *dev = analytic_floor();
+    float em[16];
+    rt_rot_y(em, (float)M_PI, 0.0f, 0.0f, 1.0f);
+    rt_place(dev, rt_quad(dev, 0.5f), em, rt_emitter(dev, AN_LE, AN_LE, AN_LE), 0);
+    MUST(sy_rt_commit(dev));
+    analytic_check(dev, square_form_factor, "area light");
+}
+
+/* A lone triangle at height 1 facing down (a polygon of three vertices: the closed form's loops
+ * take it as four slots, v0 twice), by Lambert's polygon form factor
+ * F = 1/(2 pi) |sum over edges of theta_i (n . gamma_i)|. */
+static const double g_tri[3][3] = {{-0.5, -0.5, 1.0}, {0.0, 0.5, 1.0}, {0.5, -0.5, 1.0}};
+
+static double triangle_form_factor(double x, double y)
+{
+    double v[3][3], f = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        double d[3] = {g_tri[k][0] - x, g_tri[k][1] - y, g_tri[k][2]}, l = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        for (int a = 0; a < 3; ++a) v[k][a] = d[a] / l;
+    }
+    for (int k = 0; k < 3; ++k) {
+        const double *a = v[k], *b = v[(k + 1) % 3];
+        double c[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+        f += acos(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) * c[2] / sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    }
+    return fabs(f) / (2.0 * M_PI);
+}
+
 static void test_area_light_analytic_triangle(void)
 {
-    sy_rt_device *dev = rt_device();
-    float xf[16];
-    rt_identity(xf);
-    const float albedo = 0.8f, le = 3.0f;
-    rt_place(dev, rt_quad(dev, 10.0f), xf, rt_lambert(dev, albedo, albedo, albedo), 0);
-    static const double tri[3][3] = {{-0.5, -0.5, 1.0}, {0.0, 0.5, 1.0}, {0.5, -0.5, 1.0}}; /* normal -z */
+    sy_rt_device *dev = analytic_floor();
     float *pos = malloc(9 * sizeof *pos);
     uint32_t *idx = malloc(3 * sizeof *idx);
     if (!pos || !idx) abort();
-    for (int k = 0; k < 9; ++k) pos[k] = (float)tri[k / 3][k % 3];
+    for (int k = 0; k < 9; ++k) pos[k] = (float)g_tri[k / 3][k % 3];
     for (uint32_t k = 0; k < 3; ++k) idx[k] = k;
-    rt_place(dev, rt_mesh_take(dev, pos, idx, 3, 1), xf, rt_emitter(dev, le, le, le), 0);
+    rt_place(dev, rt_mesh_take(dev, pos, idx, 3, 1), NULL, rt_emitter(dev, AN_LE, AN_LE, AN_LE), 0);
     MUST(sy_rt_commit(dev));
-    sy_rt_camera cam = rt_camera(0.5f, TAN);
-    sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, W, W);
-    float *one, *many, *depth;
-    rd.area_light_samples = 1;
-    rt_render(dev, &cam, &rd, &one, &depth);
-    free(depth);
-    rd.area_light_samples = 256;
-    rt_render(dev, &cam, &rd, &many, &depth);
-    double worst = 0.0, worst_n = 0.0;
-    for (int py = 0; py < W; ++py)
-        for (int px = 0; px < W; ++px) {
-            double x, y, v[3][3], f = 0.0;
-            pixel_point(px, py, 0.5f, &x, &y);
-            for (int k = 0; k < 3; ++k) {
-                double d[3] = {tri[k][0] - x, tri[k][1] - y, tri[k][2]}, l = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-                for (int a = 0; a < 3; ++a) v[k][a] = d[a] / l;
-            }
-            for (int k = 0; k < 3; ++k) {
-                const double *a = v[k], *b = v[(k + 1) % 3];
-                double c[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-                double cl = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-                f += acos(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) * c[2] / cl;
-            }
-            double expect = albedo * le * fabs(f) / (2.0 * M_PI);
-            const float *c1 = px_at(one, px, py), *cn = px_at(many, px, py);
-            double r1 = fabs(c1[0] / expect - 1.0), rn = fabs(c1[0] / cn[0] - 1.0);
-            if (r1 > worst) worst = r1;
-            if (rn > worst_n) worst_n = rn;
-        }
-    printf("analytic triangle light: worst pixel %.4f %% from the form factor (1 sample), %.2g from 256 samples\n",
-           100.0 * worst, worst_n);
-    EXPECT_MSG(worst < 0.003, "analytic triangle light: a pixel %.4f %% from the exact irradiance", 100.0 * worst);
-    EXPECT_MSG(worst_n < 1e-5, "analytic triangle light: 1 and 256 samples differ by %.3g", worst_n);
-    free(one);
-    rt_image_free(many, depth);
-    sy_rt_device_destroy(dev);
+    analytic_check(dev, triangle_form_factor, "triangle light");
 }
 
 /* A rough metal sphere under an environment map with a bright patch (sky gradient, a "sun" 50 x
