@@ -15,6 +15,7 @@ Needs NumPy (Debian: python3-numpy; /usr/bin/python3 has it where the suite's Py
 import argparse
 import json
 import math
+import os
 import struct
 
 import numpy as np
@@ -73,7 +74,6 @@ def main():
         f.write(struct.pack("<III", 0x46546C67, 2, 12 + 8 + len(js) + 8 + len(blob)))
         f.write(struct.pack("<II", len(js), 0x4E4F534A) + js)
         f.write(struct.pack("<II", len(blob), 0x004E4942) + bytes(blob))
-    import os
     os.replace(tmp, a.out)
     print(f"{a.out}: {len(idx) // 3} triangles, {len(pos)} vertices")
 
