@@ -145,6 +145,7 @@ sy_gl_result sy_gli_view_make(sy_gl_device *dev, const sy_gl_camera *cam, const 
     }
     sy_gli_projection(v->ortho, l2, r2, b2, t2, n, f, v->proj);
     v->ppu = (float)((double)d->height / (t2 - b2));
+    sy_gli_view_bounds(v);
     return SY_GL_OK;
 }
 
@@ -815,7 +816,7 @@ sy_gl_result sy_gli_draw_scene(sy_gl_device *dev, const view_setup *v, uint32_t 
             if (skip == UINT32_MAX) dev->culled++;
             continue;
         }
-        in->lod = sy_gli_choose_lod(dev, m, v, c, r, scale);
+        in->lod = sy_gli_choose_lod(dev, in, m, v, c, r, scale);
         in->px_per_tri = sy_gli_pixels_per_triangle(dev, m, in->lod, v, c, r);
         const mat_o *mt = sy_gli_pool_get(&dev->materials, in->material.id);
         sy_gl_alpha_mode mode = mt ? mt->d.alpha_mode : SY_GL_ALPHA_OPAQUE;

@@ -353,6 +353,10 @@ typedef struct view_setup {
     bool ortho;
     float ppu; /* pixels per unit of the image plane at distance 1 (perspective) or per metre (ortho); 0 =
                 * unknown (levels of detail off) */
+    /* sy_gli_view_bounds: the frustum's planes (sy_gli_frustum_planes) and the near plane's corners;
+     * bounds_ok false until then, or where proj x view is not invertible */
+    float planes[6][4], near_pts[4][3];
+    bool bounds_ok;
 } view_setup;
 
 typedef struct draw_ctx {
@@ -457,14 +461,30 @@ const mat_o *sy_gli_bind_material(sy_gl_device *dev, sy_gl_material id, bool all
 /* Pixels per world unit at the nearest point of the sphere (c, r) in view v; 0 when unknown (no
  * scale, or the view inside the sphere). Levels of detail, deferred shading and probe sizes use it. */
 float sy_gli_sphere_px_per_unit(const view_setup *v, const float c[3], float r);
+/* Fills v's planes and near-plane corners from its proj and view (every view that draws the
+ * scene: levels of detail look at the part of each box inside the frustum). */
+void sy_gli_view_bounds(view_setup *v);
 void sy_gli_choose_lods(sy_gl_device *dev, const view_setup *v);
-uint32_t sy_gli_choose_lod(const sy_gl_device *dev, const mesh_o *m, const view_setup *v, const float c[3], float r,
-                           float scale);
+/* Instance in's level for view v: the coarsest whose deviation, projected at the nearest point of
+ * its world box inside v's frustum (at least the nearest point of its sphere (c, r), scale its
+ * largest axis scale: sy_gli_world_sphere), stays within dev->lod_pixels pixels. */
+uint32_t sy_gli_choose_lod(const sy_gl_device *dev, const inst_o *in, const mesh_o *m, const view_setup *v,
+                           const float c[3], float r, float scale);
 float sy_gli_pixels_per_triangle(const sy_gl_device *dev, const mesh_o *m, uint32_t lod, const view_setup *v,
                                  const float c[3], float r);
 
 /* sy_gl_shadows.c */
 void sy_gli_scene_bounds(const sy_gl_device *dev, float *c, float *radius);
+/* The eight corners (k = 0..7: bit 0 x, 1 y, 2 z at the maximum) of instance in's world box: its
+ * mesh's box through its model matrix (a parallelepiped). */
+static inline void sy_gli_instance_box(const inst_o *in, const mesh_o *m, float box[8][3])
+{
+    for (int k = 0; k < 8; ++k) {
+        float p[3] = {k & 1 ? m->bmax[0] : m->bmin[0], k & 2 ? m->bmax[1] : m->bmin[1], k & 4 ? m->bmax[2] : m->bmin[2]};
+        for (int a = 0; a < 3; ++a)
+            box[k][a] = in->model[a] * p[0] + in->model[4 + a] * p[1] + in->model[8 + a] * p[2] + in->model[12 + a];
+    }
+}
 /* The eight corners (k = 0..7: bit 0 x, 1 y, 2 z at the maximum) of the world box (its mesh's box
  * transformed) of the next visible instance with a mesh from slot *i on; *i moves past it. False
  * when none is left: `for (uint32_t i = 0; sy_gli_next_box(dev, &i, box);)` visits every one. */
@@ -475,11 +495,7 @@ static inline bool sy_gli_next_box(const sy_gl_device *dev, uint32_t *i, float b
         if (!in->h.id || !in->visible) continue;
         const mesh_o *m = sy_gli_pool_get(&dev->meshes, in->mesh.id);
         if (!m) continue;
-        for (int k = 0; k < 8; ++k) {
-            float p[3] = {k & 1 ? m->bmax[0] : m->bmin[0], k & 2 ? m->bmax[1] : m->bmin[1], k & 4 ? m->bmax[2] : m->bmin[2]};
-            for (int a = 0; a < 3; ++a)
-                box[k][a] = in->model[a] * p[0] + in->model[4 + a] * p[1] + in->model[8 + a] * p[2] + in->model[12 + a];
-        }
+        sy_gli_instance_box(in, m, box);
         ++*i;
         return true;
     }

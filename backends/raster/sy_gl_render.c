@@ -124,6 +124,7 @@ static sy_gl_result render_probes(sy_gl_device *dev, sy_gl_report *rep)
             v.ppu = (float)ps / 2.0f;
             memcpy(v.cam_pos, c, sizeof v.cam_pos);
             memcpy(v.cam_fwd, sy_gli_cube_faces[f][2], sizeof v.cam_fwd);
+            sy_gli_view_bounds(&v);
             gl->BindFramebuffer(GL_FRAMEBUFFER, dev->probe_fbo);
             gl->FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f,
                                      dev->probes[p].cube, 0);
@@ -231,6 +232,7 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
         dev->probes_dirty = false;
     }
     sy_gli_profile_mark(dev, false, prof[2]);
+    const uint64_t probe_tris = dev->tris; /* (shadow maps do not count theirs) */
     sy_gli_begin_target(dev, &v);
     sy_gli_bind_frame_resources(dev);
     r = sy_gli_draw_scene(dev, &v, UINT32_MAX, rep);
@@ -243,9 +245,10 @@ sy_gl_result sy_gl_render(sy_gl_device *dev, const sy_gl_camera *cam, const sy_g
         for (int i = 0; i < 5; ++i) prof[5][0] += prof[i][0], prof[5][1] += prof[i][1];
         fprintf(stderr,
                 "raster profile: frame %.3f s (cpu %.3f): environment %.3f (%.3f), shadows %.3f (%.3f), probes %u %.3f "
-                "(%.3f), main %.3f (%.3f), resolve and read-back %.3f (%.3f)\n",
+                "(%.3f), main %.3f (%.3f), resolve and read-back %.3f (%.3f); triangles drawn: probes %llu, main %llu\n",
                 prof[5][0], prof[5][1], prof[0][0], prof[0][1], prof[1][0], prof[1][1], dev->probe_count, prof[2][0],
-                prof[2][1], prof[3][0], prof[3][1], prof[4][0], prof[4][1]);
+                prof[2][1], prof[3][0], prof[3][1], prof[4][0], prof[4][1], (unsigned long long)probe_tris,
+                (unsigned long long)(dev->tris - probe_tris));
     }
     return r;
 }
@@ -274,7 +277,7 @@ sy_gl_result sy_gl_render_floor(sy_gl_device *dev, const sy_gl_camera *cam, cons
         if (!m) continue;
         float c[3], scale, r = sy_gli_world_sphere(in, m, c, &scale);
         if (sy_gli_sphere_outside(planes, c, r)) continue;
-        in->lod = sy_gli_choose_lod(dev, m, &v, c, r, scale);
+        in->lod = sy_gli_choose_lod(dev, in, m, &v, c, r, scale);
         gl->UniformMatrix4fv(dev->uf[k].model, 1, GL_FALSE, in->model);
         dev->tris += sy_gli_draw_mesh_lod(dev, m, in->lod);
     }

@@ -4,7 +4,8 @@
  * instance behind the camera is culled and draws nothing; a mirror's scene probe draws levels
  * too; with levels off every triangle is drawn; a mesh under SY_GL_LOD_MIN_TRIANGLES has no levels;
  * a closed cube (back faces culled) shows its near side from outside, mirrored too, and its far
- * side from inside or through a near plane that cuts it; a mesh above 2^21 triangles (levels
+ * side from inside or through a near plane that cuts it; a floor reaching under the camera draws a
+ * level chosen where the view sees it (not level 0 for a bounding sphere that holds the eye); a mesh above 2^21 triangles (levels
  * simplified in pieces) draws a small level far away that covers what the full mesh covers. OSMesa. */
 #include "sy_gl.h"
 
@@ -72,7 +73,7 @@ int main(void)
     MUST(sy_gl_instance_create(d, &id, &inst));
 
     /* Far: the sphere covers ~16 px across (dist 12, window 1 wide at 1 m). */
-    const float dists[2] = {12.0f, 3.0f};
+    const float dists[2] = {12.0f, 2.0f};
     uint64_t drawn_at[2];
     for (int k = 0; k < 2; ++k) {
         sy_gl_set_lod(d, SY_GL_LOD_PIXELS_DEFAULT);
@@ -129,7 +130,7 @@ int main(void)
     /* A small mesh has no levels: all its triangles at any distance. */
     MUST(sy_gl_instance_destroy(d, inst));
     uint32_t small_tris = 0;
-    sy_gl_mesh small = gl_test_sphere(d, 32, 0.03f, true, &small_tris);
+    sy_gl_mesh small = gl_test_sphere(d, 16, 0.03f, true, &small_tris);
     EXPECT_MSG(small_tris < SY_GL_LOD_MIN_TRIANGLES, "small sphere: %u triangles", small_tris);
     id.mesh = small;
     translate(id.transform, 0, 0, 0);
@@ -188,6 +189,49 @@ int main(void)
             EXPECT_MSG(fabsf(z - views[k].want) < 0.05f, "closed cube, %s: centre depth %g, want %g", views[k].what,
                        (double)z, (double)views[k].want);
         }
+    }
+
+    /* A floor reaching under and behind the camera: its bounding sphere holds the eye, so the
+     * sphere alone says nothing about its size in view (it drew level 0: TransmissionTest's
+     * 43,779-triangle backdrop, issue 32); the part of its box inside the frustum begins about 2 m
+     * ahead (1 m below the eye, the view's lower edge 26.6 degrees down), and a level within half a
+     * pixel there is drawn, with the full mesh's coverage and depth. */
+    {
+        enum { G = 160 };
+        static float fp[(G + 1) * (G + 1) * 3];
+        static uint32_t fi[G * G * 6];
+        uint32_t ft = 0;
+        for (int i = 0; i <= G; ++i)
+            for (int j = 0; j <= G; ++j) {
+                float *v = fp + 3 * (i * (G + 1) + j), x = -40.0f + 80.0f * (float)j / G, z = -40.0f + 80.0f * (float)i / G;
+                v[0] = x, v[1] = -1.0f + 0.004f * sinf(1.3f * x) * cosf(1.7f * z), v[2] = z;
+            }
+        for (uint32_t i = 0; i < G; ++i)
+            for (uint32_t j = 0; j < G; ++j) {
+                uint32_t a = i * (G + 1) + j, b = a + G + 1, *t = fi + 3 * ft;
+                t[0] = a, t[1] = b, t[2] = a + 1, t[3] = a + 1, t[4] = b, t[5] = b + 1;
+                ft += 2;
+            }
+        sy_gl_mesh_desc fd = {.positions = fp, .indices = fi, .vertex_count = (G + 1) * (G + 1), .triangle_count = ft};
+        sy_gl_mesh floor_mesh;
+        MUST(sy_gl_mesh_create(d, &fd, &floor_mesh));
+        MUST(sy_gl_instance_destroy(d, inst));
+        id.mesh = floor_mesh;
+        translate(id.transform, 0, 0, 0);
+        MUST(sy_gl_instance_create(d, &id, &inst));
+        uint64_t fdrawn[2];
+        for (int k = 0; k < 2; ++k) {
+            sy_gl_set_lod(d, k ? 0.0f : SY_GL_LOD_PIXELS_DEFAULT);
+            fdrawn[k] = draw(d, 0.0f, k, NULL);
+        }
+        double drel, io = iou(&drel);
+        printf("floor under the eye: %llu of %llu triangles drawn, coverage IoU %.4f, depth off by > 1 %% in %.2f %% of pixels\n",
+               (unsigned long long)fdrawn[0], (unsigned long long)fdrawn[1], io, 100.0 * drel);
+        EXPECT_MSG(fdrawn[1] == ft, "floor, levels off: %llu triangles drawn, want %u", (unsigned long long)fdrawn[1], ft);
+        EXPECT_MSG(fdrawn[0] * 4 <= ft, "floor under the eye: %llu of %u triangles drawn (want a simplified level)",
+                   (unsigned long long)fdrawn[0], ft);
+        EXPECT_MSG(io >= 0.99 && drel <= 0.01, "floor under the eye: coverage IoU %.4f, depth off in %.2f %% of the pixels", io,
+                   100.0 * drel);
     }
 
     /* A mesh above 2^21 triangles: its levels are simplified in pieces (Morton order, locked
