@@ -77,7 +77,8 @@ static scene build(bool forward)
     MUST(sy_gl_device_create(&dd, &s.d));
     sy_gl_device *d = s.d;
     /* levels of detail off: the spheres keep the small triangles deferred shading is for (with
-     * levels the faceted one, 8,064 triangles, draws a level of a few hundred, shaded forward) */
+     * levels the smooth ones, 18,240 triangles, draw a level whose triangles are large enough on
+     * screen to be shaded forward) */
     sy_gl_set_lod(d, 0.0f);
     s.smooth = gl_test_sphere(d, 96, 0.0f, true, NULL);
     sy_gl_mesh faceted = gl_test_sphere(d, 64, 0.0f, false, NULL);
