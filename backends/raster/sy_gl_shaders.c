@@ -489,7 +489,7 @@ const char *const sy_gl_main_fs =
     /* the transmission texture (R), the layers' slot 11 (its uv set m_lt2.w, transform m_lxf[22..23]):
      * read by the transmissive variant, not the layered one (whose size on every pixel of
      * TransmissionTest's textured glass made its frame 5 times slower on llvmpipe) */
-    "#if defined(SY_TRANS) && defined(SY_TEX)\n"
+    "#if defined(SY_TRANS) && defined(SY_TEX) && defined(SY_LX11)\n"
     "    if (m_lt2.w >= 0) { vec3 h = vec3(UVSET(m_lt2.w), 1.0);\n"
     "      trans *= texture(t_l11, vec2(dot(m_lxf[22].xyz, h), dot(m_lxf[23].xyz, h))).r; }\n"
     "#endif\n"
