@@ -425,19 +425,23 @@ static int material_features(const sy_gl_device *dev, const mat_o *mt)
     return v;
 }
 
-/* The layer textures material mt samples (bit k: slot k of sy_gli_layer_refs, where its material
+/* The texture slots material mt samples (the layers' and the five base ones, where its material
  * block's uv set is not -1: sy_gli_material_block) and whether it has iridescence or anisotropy
- * (dev->layer_sig). Any material counts, layered or not: a program of the frame's shared features
- * draws every material, and reads the textures its block names. */
-static uint32_t layer_features(const sy_gl_device *dev, const mat_o *mt)
+ * (dev->material_sig). Any material counts, layered or not: a program of the frame's shared
+ * features draws every material, and reads the textures its block names. */
+static uint32_t texture_features(const sy_gl_device *dev, const mat_o *mt)
 {
     uint32_t s = 0;
     const sy_gl_texture_ref *lr[LAYER_TEXTURES];
     sy_gli_layer_refs(&mt->d, lr);
     for (int i = 0; i < LAYER_TEXTURES && dev->layer_units; ++i)
         if (sy_gli_pool_get(&dev->textures, lr[i]->texture.id)) s |= 1u << i;
-    if (mt->d.iridescence > 0.0f) s |= LAYER_SIG_IRID;
-    if (mt->d.anisotropy > 0.0f) s |= LAYER_SIG_ANISO;
+    const sy_gl_texture_ref *refs[5] = {&mt->d.base_color_texture, &mt->d.metallic_roughness_texture,
+                                        &mt->d.normal_texture, &mt->d.occlusion_texture, &mt->d.emissive_texture};
+    for (int i = 0; i < 5; ++i)
+        if (sy_gli_pool_get(&dev->textures, refs[i]->texture.id)) s |= 1u << (MSIG_BASE_SHIFT + i);
+    if (mt->d.iridescence > 0.0f) s |= MSIG_IRID;
+    if (mt->d.anisotropy > 0.0f) s |= MSIG_ANISO;
     return s;
 }
 
@@ -448,12 +452,12 @@ static uint32_t layer_features(const sy_gl_device *dev, const mat_o *mt)
  * shaders take for absent attributes (uv 0, colour 1: sy_gli_draw_mesh_lod), so it shades as
  * before, and llvmpipe compiles one program instead of a lean and a full one (issue 32:
  * TextureTransformMultiTest's layered variant, about 1 s of LLVM each). In the same pass: the
- * sampling the stand-ins follow (sy_gli_standins_follow), and the layers' features (layer_features). */
+ * sampling the stand-ins follow (sy_gli_standins_follow), and the texture slots in use (texture_features). */
 void sy_gli_frame_features(sy_gl_device *dev)
 {
     int shared = 0;
     bool full = false;
-    uint32_t want[STANDINS], layer_sig = 0;
+    uint32_t want[STANDINS], material_sig = 0;
     for (int k = 0; k < STANDINS; ++k) want[k] = STANDIN_ANY;
     const mat_o *last = NULL;
     for (uint32_t i = 0; i < dev->instances.count; ++i) {
@@ -462,7 +466,7 @@ void sy_gli_frame_features(sy_gl_device *dev)
         const mat_o *mt = sy_gli_pool_get(&dev->materials, in->material.id);
         if (mt && mt != last) {
             shared |= material_features(dev, last = mt);
-            layer_sig |= layer_features(dev, mt);
+            material_sig |= texture_features(dev, mt);
             sy_gli_standins_want(dev, mt, want);
         }
         const mesh_o *m = full ? NULL : sy_gli_pool_get(&dev->meshes, in->mesh.id);
@@ -470,7 +474,7 @@ void sy_gli_frame_features(sy_gl_device *dev)
     }
     dev->shared_features = shared;
     dev->shared_full = full;
-    dev->layer_sig = layer_sig;
+    dev->material_sig = material_sig;
     sy_gli_standins_follow(dev, want);
 }
 

@@ -39,9 +39,12 @@ enum { UNIT_BASE = 0, UNIT_MR, UNIT_NRM, UNIT_OCC, UNIT_EMIS, UNIT_SHADOW, UNIT_
  * colour, clear coat, coat roughness, coat normal, sheen colour, sheen roughness, thickness,
  * anisotropy, iridescence, iridescence thickness, transmission */
 #define LAYER_TEXTURES 12
-#define LAYER_SIG_IRID (1u << LAYER_TEXTURES)
-#define LAYER_SIG_ANISO (2u << LAYER_TEXTURES)
-#define LAYER_SIG_SHIFT 16 /* where variant_sig (sy_gl_programs.c) keeps the layer features it depends on */
+/* dev->material_sig: bits 0 .. LAYER_TEXTURES - 1 the layer slots, then these, then the five base
+ * slots (base colour, metal-roughness, normal, occlusion, emission) from MSIG_BASE_SHIFT */
+#define MSIG_IRID (1u << LAYER_TEXTURES)
+#define MSIG_ANISO (2u << LAYER_TEXTURES)
+#define MSIG_BASE_SHIFT (LAYER_TEXTURES + 2)
+#define MSIG_SHIFT 16 /* where variant_sig (sy_gl_programs.c) keeps the material features it depends on */
 #define STANDINS (5 + LAYER_TEXTURES) /* material units with a stand-in: the five base slots, the layers' */
 static inline void sy_gli_layer_refs(const sy_gl_material_desc *d, const sy_gl_texture_ref *r[LAYER_TEXTURES])
 {
@@ -319,10 +322,11 @@ struct sy_gl_device {
     size_t scratch_len;
     int shared_features; /* material_features of every visible instance (sy_gli_frame_features) */
     bool shared_full;    /* a visible mesh is not VAR_LEAN: no forward draw is (sy_gli_frame_features) */
-    /* sy_gli_frame_features: bit k (0 .. LAYER_TEXTURES - 1) some visible material has a texture in
-     * layer slot k (sy_gli_layer_refs), LAYER_SIG_IRID one has iridescence, LAYER_SIG_ANISO one
-     * anisotropy; the programs that read them compile only those (variant_sig) */
-    uint32_t layer_sig;
+    /* sy_gli_frame_features: the texture slots some visible material samples (bit k < LAYER_TEXTURES:
+     * layer slot k of sy_gli_layer_refs; bit MSIG_BASE_SHIFT + k: base slot k, UNIT_BASE ..
+     * UNIT_EMIS), MSIG_IRID one has iridescence, MSIG_ANISO one anisotropy; the programs that read
+     * them compile only those (variant_sig) */
+    uint32_t material_sig;
 };
 
 static inline float sy_gli_dot3f(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }

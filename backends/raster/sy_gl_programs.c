@@ -246,16 +246,19 @@ static uint64_t variant_sig(const sy_gl_device *dev, int v)
     uint64_t s = 0;
     if ((v & VAR_SHADOW) && ((v >> VAR_NL_SHIFT) & 7)) s |= dev->light_sig & 0x3FFFu;
     if ((v & VAR_LIGHTS) && ((v >> VAR_NL_SHIFT) & 7)) s |= dev->light_sig & (0x3FFFull << 48);
-    /* bits 16 ..: the layer features the frame's materials have (dev->layer_sig), where the
-     * program reads them: the layers' texture slots 0 .. 10 (SY_LAYERS with SY_TEX), iridescence and
-     * anisotropy (SY_LAYERS), the transmission texture, slot 11 (SY_TRANS with SY_TEX). llvmpipe
-     * compiles every texture look-up of a program whether a material takes its branch or not: the
-     * layered programs' eleven look-ups were about 0.2 s of their 0.6-0.7 s compile (issue 32) */
+    /* bits MSIG_SHIFT ..: the material features of the frame (dev->material_sig) where the program
+     * reads them: the base slots and the layers' texture slots 0 .. 10 (SY_TEX; the layers' with
+     * SY_LAYERS), iridescence and anisotropy (SY_LAYERS), the transmission texture, layer slot 11
+     * (SY_TRANS with SY_TEX). llvmpipe compiles every texture look-up of a program whether a
+     * material takes its branch or not: the layered programs' eleven look-ups were about 0.2 s of
+     * their 0.6-0.7 s compile (issue 32) */
+    const uint32_t ms = dev->material_sig, base = 31u << MSIG_BASE_SHIFT;
     uint32_t l = 0;
-    if ((v & VAR_LAYERS) && (v & VAR_TEX)) l |= dev->layer_sig & ((1u << 11) - 1u);
-    if (v & VAR_LAYERS) l |= dev->layer_sig & (LAYER_SIG_IRID | LAYER_SIG_ANISO);
-    if ((v & VAR_TRANS) && (v & VAR_TEX)) l |= dev->layer_sig & (1u << 11);
-    return s | (uint64_t)l << LAYER_SIG_SHIFT;
+    if (v & VAR_TEX) l |= ms & base;
+    if ((v & VAR_LAYERS) && (v & VAR_TEX)) l |= ms & ((1u << 11) - 1u);
+    if (v & VAR_LAYERS) l |= ms & (MSIG_IRID | MSIG_ANISO);
+    if ((v & VAR_TRANS) && (v & VAR_TEX)) l |= ms & (1u << 11);
+    return s | (uint64_t)l << MSIG_SHIFT;
 }
 
 /* The #defines of variant bits v and the lights' signature sig (variant_sig) (sy_gl_shaders.c)
@@ -279,19 +282,23 @@ static void variant_defines(int v, uint64_t sig, char *defs, size_t defs_len, ch
         dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_%s 1\n", more[k].name);
         nl += (size_t)snprintf(name + nl, name_len - nl, " %s", more[k].name);
     }
-    const uint32_t layer = (uint32_t)(sig >> LAYER_SIG_SHIFT);
-    if (layer & ((1u << LAYER_TEXTURES) - 1u)) nl += (size_t)snprintf(name + nl, name_len - nl, " (layer textures");
-    for (int k = 0; k < LAYER_TEXTURES; ++k)
-        if (layer & (1u << k)) {
-            dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_LX%d 1\n", k);
-            nl += (size_t)snprintf(name + nl, name_len - nl, " %d", k);
+    const uint32_t ms = (uint32_t)(sig >> MSIG_SHIFT);
+    static const char *const base_names[5] = {"base", "mr", "nrm", "occ", "emis"};
+    for (int k = 0; k < 5; ++k)
+        if (ms & (1u << (MSIG_BASE_SHIFT + k))) {
+            dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_TX%d 1\n", k);
+            nl += (size_t)snprintf(name + nl, name_len - nl, " %s", base_names[k]);
         }
-    if (layer & ((1u << LAYER_TEXTURES) - 1u)) nl += (size_t)snprintf(name + nl, name_len - nl, ")");
-    if (layer & LAYER_SIG_IRID) {
+    for (int k = 0; k < LAYER_TEXTURES; ++k)
+        if (ms & (1u << k)) {
+            dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_LX%d 1\n", k);
+            nl += (size_t)snprintf(name + nl, name_len - nl, " l%d", k);
+        }
+    if (ms & MSIG_IRID) {
         dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_IRID 1\n");
         nl += (size_t)snprintf(name + nl, name_len - nl, " IRID");
     }
-    if (layer & LAYER_SIG_ANISO) {
+    if (ms & MSIG_ANISO) {
         dl += (size_t)snprintf(defs + dl, defs_len - dl, "#define SY_ANISO 1\n");
         nl += (size_t)snprintf(name + nl, name_len - nl, " ANISO");
     }
