@@ -207,6 +207,7 @@ void sy_gl_device_destroy(sy_gl_device *dev)
         gl->DeleteVertexArrays(1, &dev->empty_vao);
     }
     sy_gl_context_destroy(dev->ctx);
+    sy_gli_lod_cache_free(dev);
     free(dev->meshes.items);
     free(dev->textures.items);
     free(dev->materials.items);

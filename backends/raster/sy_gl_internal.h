@@ -98,6 +98,8 @@ static inline void *sy_gli_pool_at(const pool *p, uint32_t i) { return (char *)p
 /* Levels of detail (meshoptimizer): level 0 is the mesh; each further level is simplified from the
  * one before to about a quarter of its triangles, all levels in one index buffer. */
 #define LOD_MAX 12
+#define LOD_CACHE_ENTRIES 8u          /* sy_gl_device.lod_cache */
+#define LOD_CACHE_MAX_TRIANGLES (1u << 18) /* meshes above it are not kept (their levels' indices) */
 
 typedef struct mesh_o {
     slot_head h;
@@ -327,6 +329,16 @@ struct sy_gl_device {
      * UNIT_EMIS), MSIG_IRID one has iridescence, MSIG_ANISO one anisotropy; the programs that read
      * them compile only those (variant_sig) */
     uint32_t material_sig;
+    /* the levels of detail of the last meshes created (sy_gl_objects.c, lod_cache_*): a file that
+     * repeats a mesh as separate meshes (MetalRoughSpheresNoTextures' 98 spheres) simplifies and
+     * measures it once */
+    struct lod_cache_entry {
+        uint64_t hash, used; /* xxh3 of the mesh's data; the creation that last used it (0: empty) */
+        mesh_o mesh;         /* its counts and lod_* fields: the levels' description */
+        uint32_t *levels; /* the levels' indices after level 0 (malloc'd), level_indices of them */
+        size_t level_indices;
+    } lod_cache[LOD_CACHE_ENTRIES];
+    uint64_t lod_cache_clock;
 };
 
 static inline float sy_gli_dot3f(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
@@ -459,6 +471,7 @@ bool sy_gli_mtab_set(sy_gl_device *dev, uint32_t row, const sy_gl_material_desc 
 void sy_gli_mtab_upload(sy_gl_device *dev);
 
 /* sy_gl_objects.c */
+void sy_gli_lod_cache_free(sy_gl_device *dev); /* dev->lod_cache emptied */
 /* Levels 1.. of cube map `cube` (side x side texels per face, a power of two, RGBA16F) from each
  * face's level 0, read back through framebuffer fbo (its colour attachment 0 is left on the last
  * face): the box filter of 2D textures' mipmaps (upload_levels), on the CPU. glGenerateMipmap on
@@ -468,6 +481,26 @@ sy_gl_result sy_gli_cube_mipmaps(sy_gl_device *dev, GLuint cube, GLuint fbo, uin
 
 /* sy_gl_lod.c */
 uint32_t sy_gli_draw_mesh_lod(sy_gl_device *dev, const mesh_o *m, uint32_t lod);
+/* The deviation of a level of detail from its mesh as measured (level: its tris triangles'
+ * indices into d's vertices; bmin, bmax d's box; tol: the positional deviation meshoptimizer
+ * reports): a length in object space that levels are chosen by (sy_gli_choose_lod). At the
+ * centroids of up to LOD_CHECK_SAMPLES of the mesh's triangles (evenly spread over its index list)
+ * the level's nearest triangles are found through a grid; of those facing the sample's way and
+ * within tol of the nearest of them (both sides of a uv seam or a crease), the one that matches
+ * best counts: its distance, the angle a
+ * between the normals (vertex normals interpolated, or the faces' without them: the rasterizer's
+ * flat normals) times half its longest edge (the shading moves by about a across it), and the
+ * distance in uv0 times the metres per uv unit of the sample's triangle (the square root of its
+ * area over its uv area: a sphere's uv is dense at its poles). The largest over the samples; INFINITY where a sample finds no level triangle within
+ * reach, or without memory (the level is not used). meshoptimizer 0.18 simplifies positions alone:
+ * a level half a pixel from the mesh's surface can shade it otherwise (NormalTangentTest's bumped
+ * tiles 4.7 % brighter, issue 32). */
+float sy_gli_level_shading_error(const sy_gl_mesh_desc *d, const float bmin[3], const float bmax[3], const uint32_t *level,
+                                 size_t tris, float tol);
+#define LOD_CHECK_SAMPLES 1024u
+#define LOD_CHECK_CELLS (1u << 18) /* the grid's cells at most */
+#define LOD_CHECK_NEAR 32u         /* a sample's nearest level triangles weighed */
+#define LOD_CHECK_CELL_REFS 32u /* grid entries per level triangle at most (else no bound: about 7 on the samples) */
 const mat_o *sy_gli_bind_material(sy_gl_device *dev, sy_gl_material id, bool all_textures);
 /* Pixels per world unit at the nearest point of the sphere (c, r) in view v; 0 when unknown (no
  * scale, or the view inside the sphere). Levels of detail, deferred shading and probe sizes use it. */

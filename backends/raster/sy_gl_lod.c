@@ -213,3 +213,234 @@ float sy_gli_pixels_per_triangle(const sy_gl_device *dev, const mesh_o *m, uint3
     uint32_t tris = m->lod_tris[lod < m->lod_count ? lod : 0];
     return tris ? area / (float)tris : screen;
 }
+
+/* >>level shading deviation (at creation, sy_gl_objects.c build_lods) */
+
+/* The closest point of triangle (a, b, c) to p: its barycentric weights into w (Ericson, Real-Time
+ * Collision Detection, 5.1.5); returns the squared distance. */
+static float closest_on_triangle(const float p[3], const float a[3], const float b[3], const float c[3], float w[3])
+{
+    float ab[3], ac[3], ap[3];
+    for (int k = 0; k < 3; ++k) ab[k] = b[k] - a[k], ac[k] = c[k] - a[k], ap[k] = p[k] - a[k];
+    float d1 = dot3(ab, ap), d2 = dot3(ac, ap);
+    if (d1 <= 0.0f && d2 <= 0.0f) w[0] = 1.0f, w[1] = w[2] = 0.0f;
+    else {
+        float bp[3], cp[3];
+        for (int k = 0; k < 3; ++k) bp[k] = p[k] - b[k], cp[k] = p[k] - c[k];
+        float d3 = dot3(ab, bp), d4 = dot3(ac, bp), d5 = dot3(ab, cp), d6 = dot3(ac, cp);
+        float vc = d1 * d4 - d3 * d2, vb = d5 * d2 - d1 * d6, va = d3 * d6 - d5 * d4;
+        if (d3 >= 0.0f && d4 <= d3) w[1] = 1.0f, w[0] = w[2] = 0.0f;
+        else if (d6 >= 0.0f && d5 <= d6) w[2] = 1.0f, w[0] = w[1] = 0.0f;
+        else if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f) {
+            float v = d1 / (d1 - d3);
+            w[0] = 1.0f - v, w[1] = v, w[2] = 0.0f;
+        } else if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) {
+            float v = d2 / (d2 - d6);
+            w[0] = 1.0f - v, w[1] = 0.0f, w[2] = v;
+        } else if (va <= 0.0f && (d4 - d3) >= 0.0f && (d5 - d6) >= 0.0f) {
+            float v = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+            w[0] = 0.0f, w[1] = 1.0f - v, w[2] = v;
+        } else {
+            float den = va + vb + vc, v = den != 0.0f ? vb / den : 1.0f / 3.0f, u = den != 0.0f ? vc / den : 1.0f / 3.0f;
+            w[0] = 1.0f - v - u, w[1] = v, w[2] = u;
+        }
+    }
+    float q[3], dd = 0.0f;
+    for (int k = 0; k < 3; ++k) {
+        q[k] = w[0] * a[k] + w[1] * b[k] + w[2] * c[k];
+        dd += (p[k] - q[k]) * (p[k] - q[k]);
+    }
+    return dd;
+}
+
+/* The normal of triangle t at weights w, not normalised: its vertex normals interpolated, or its
+ * face normal when the mesh has none (the rasterizer's flat normals); false when it has no
+ * direction. normal_at: the same, of unit length. */
+static bool normal_dir(const sy_gl_mesh_desc *d, const uint32_t *t, const float w[3], float n[3])
+{
+    if (d->normals) {
+        for (int k = 0; k < 3; ++k)
+            n[k] = w[0] * d->normals[3u * t[0] + k] + w[1] * d->normals[3u * t[1] + k] + w[2] * d->normals[3u * t[2] + k];
+    } else {
+        const float *a = d->positions + 3u * t[0], *b = d->positions + 3u * t[1], *c = d->positions + 3u * t[2];
+        float e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        n[0] = e1[1] * e2[2] - e1[2] * e2[1], n[1] = e1[2] * e2[0] - e1[0] * e2[2], n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    }
+    float l2 = dot3(n, n);
+    return l2 > 0.0f && isfinite(l2);
+}
+
+static bool normal_at(const sy_gl_mesh_desc *d, const uint32_t *t, const float w[3], float n[3])
+{
+    if (!normal_dir(d, t, w, n)) return false;
+    float l = sqrtf(dot3(n, n));
+    for (int k = 0; k < 3; ++k) n[k] /= l;
+    return true;
+}
+
+static void uv_at(const sy_gl_mesh_desc *d, const uint32_t *t, const float w[3], float uv[2])
+{
+    for (int k = 0; k < 2; ++k) uv[k] = w[0] * d->uv[0][2u * t[0] + k] + w[1] * d->uv[0][2u * t[1] + k] + w[2] * d->uv[0][2u * t[2] + k];
+}
+
+/* Metres (object space) per unit of uv0 on triangle t of d: the square root of its area over its
+ * area in uv0 (0 without uv0, or where either is 0: no uv term there). */
+static float metres_per_uv(const sy_gl_mesh_desc *d, const uint32_t *t)
+{
+    if (!d->uv[0]) return 0.0f;
+    const float *a = d->positions + 3u * t[0], *b = d->positions + 3u * t[1], *c = d->positions + 3u * t[2];
+    float e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    float x = e1[1] * e2[2] - e1[2] * e2[1], y = e1[2] * e2[0] - e1[0] * e2[2], z = e1[0] * e2[1] - e1[1] * e2[0];
+    const float *u0 = d->uv[0] + 2u * t[0], *u1 = d->uv[0] + 2u * t[1], *u2 = d->uv[0] + 2u * t[2];
+    float aw = sqrtf(x * x + y * y + z * z), au = fabsf((u1[0] - u0[0]) * (u2[1] - u0[1]) - (u1[1] - u0[1]) * (u2[0] - u0[0]));
+    float r = aw > 0.0f && au > 0.0f ? sqrtf(aw / au) : 0.0f;
+    return isfinite(r) ? r : 0.0f;
+}
+
+float sy_gli_level_shading_error(const sy_gl_mesh_desc *d, const float bmin[3], const float bmax[3], const uint32_t *level,
+                                 size_t tris, float tol)
+{
+    if (!d->indices || !tris) return INFINITY;
+    /* the grid: cubes of about four of the level's triangles' area each (surfaces are two-dimensional),
+     * at most LOD_CHECK_CELLS of them */
+    int g[3];
+    float ext = 0.0f;
+    double area = 0.0;
+    for (int k = 0; k < 3; ++k) ext = fmaxf(ext, bmax[k] - bmin[k]);
+    if (!(ext > 0.0f)) return 0.0f;
+    for (size_t t = 0; t < tris; ++t) {
+        float n[3];
+        const uint32_t *i = level + 3 * t;
+        const float *a = d->positions + 3u * i[0], *b = d->positions + 3u * i[1], *c = d->positions + 3u * i[2];
+        float e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        n[0] = e1[1] * e2[2] - e1[2] * e2[1], n[1] = e1[2] * e2[0] - e1[0] * e2[2], n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        area += 0.5 * sqrt((double)dot3(n, n));
+    }
+    float cell = (float)sqrt(4.0 * area / (double)tris);
+    size_t cells;
+    for (;;) {
+        if (!(cell > 1e-6f * ext)) cell = 1e-6f * ext;
+        cells = 1;
+        for (int k = 0; k < 3; ++k) {
+            g[k] = (int)fminf(1024.0f, floorf((bmax[k] - bmin[k]) / cell) + 1.0f);
+            cells *= (size_t)g[k];
+        }
+        if (cells <= LOD_CHECK_CELLS) break;
+        cell *= 1.5f;
+    }
+    tol = fmaxf(tol, 1e-4f * ext);
+    const float reach = fmaxf(4.0f * tol, 0.25f * cell); /* how far from a sample its level triangle is looked for */
+    /* each triangle in every cell its box, grown by reach, touches (counting, then filling) */
+    uint32_t *start = calloc(cells + 1, sizeof *start), *list = NULL;
+    float sample_err = INFINITY;
+    if (!start) return INFINITY;
+    size_t total = 0;
+    for (int pass = 0; pass < 2; ++pass) {
+        for (size_t t = 0; t < tris && total <= LOD_CHECK_CELL_REFS * tris; ++t) {
+            int lo[3], hi[3];
+            for (int k = 0; k < 3; ++k) {
+                float a = d->positions[3u * level[3 * t] + k], b = d->positions[3u * level[3 * t + 1] + k],
+                      c = d->positions[3u * level[3 * t + 2] + k];
+                lo[k] = (int)floorf((fminf(a, fminf(b, c)) - reach - bmin[k]) / cell);
+                hi[k] = (int)floorf((fmaxf(a, fmaxf(b, c)) + reach - bmin[k]) / cell);
+                lo[k] = lo[k] < 0 ? 0 : lo[k] >= g[k] ? g[k] - 1 : lo[k];
+                hi[k] = hi[k] < 0 ? 0 : hi[k] >= g[k] ? g[k] - 1 : hi[k];
+            }
+            for (int z = lo[2]; z <= hi[2]; ++z)
+                for (int y = lo[1]; y <= hi[1]; ++y)
+                    for (int x = lo[0]; x <= hi[0]; ++x) {
+                        size_t c = ((size_t)z * g[1] + y) * g[0] + x;
+                        if (pass == 0) start[c + 1]++, total++;
+                        else list[start[c]++] = (uint32_t)t;
+                    }
+        }
+        if (pass == 0) {
+            if (total > LOD_CHECK_CELL_REFS * tris) break; /* long slivers across the grid: no bound */
+            for (size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
+            if (!(list = malloc(sizeof *list * (start[cells] ? start[cells] : 1)))) break;
+        } else
+            for (size_t c = cells; c > 0; --c) start[c] = start[c - 1]; /* the fill moved each start to its end */
+    }
+    if (list) {
+        start[0] = 0;
+        /* the samples: every triangle, or one at a hashed place in each of LOD_CHECK_SAMPLES equal
+         * runs of the index list (a fixed stride fell on the same columns of every row of a grid) */
+        const size_t n_all = d->triangle_count, n_s = n_all > LOD_CHECK_SAMPLES ? LOD_CHECK_SAMPLES : n_all;
+        sample_err = 0.0f;
+        for (size_t i = 0; i < n_s && isfinite(sample_err); ++i) {
+            size_t s = i;
+            if (n_s < n_all) {
+                uint32_t h = (uint32_t)i * 2654435761u;
+                h ^= h >> 15;
+                s = (size_t)(((double)i + (double)h / 4294967296.0) * (double)n_all / (double)n_s);
+                if (s >= n_all) s = n_all - 1;
+            }
+            const uint32_t *o = d->indices + 3 * s;
+            float p[3], w3[3] = {1.0f / 3.0f, 1.0f / 3.0f, 1.0f / 3.0f}, n0[3];
+            for (int k = 0; k < 3; ++k)
+                p[k] = (d->positions[3u * o[0] + k] + d->positions[3u * o[1] + k] + d->positions[3u * o[2] + k]) / 3.0f;
+            if (!normal_at(d, o, w3, n0)) continue; /* a degenerate triangle of the mesh shades nothing */
+            const float s_uv = metres_per_uv(d, o);
+            size_t c = 0;
+            for (int k = 2; k >= 0; --k) {
+                int i = (int)floorf((p[k] - bmin[k]) / cell);
+                c = c * (size_t)g[k] + (size_t)(i < 0 ? 0 : i >= g[k] ? g[k] - 1 : i);
+            }
+            /* the level's surface at the sample: of its triangles within reach, those facing the
+             * sample's way (a thin shell's two sides lie within reach of each other), the nearest
+             * and those about as near (within tol: both sides of a uv seam or a crease), the one
+             * whose normal and uv are closest to the sample's; the others where none faces its way.
+             * The candidates are kept (up to LOD_CHECK_NEAR; beyond, the nearest replace the
+             * farthest) and then weighed. */
+            struct { float dist, w[3]; uint32_t tri; bool facing; } cand[LOD_CHECK_NEAR];
+            uint32_t nc = 0;
+            float best[2] = {INFINITY, INFINITY}, err = INFINITY;
+            for (uint32_t j = start[c]; j < start[c + 1]; ++j) {
+                const uint32_t *t = level + 3u * list[j];
+                float wj[3], n1[3], dd = closest_on_triangle(p, d->positions + 3u * t[0], d->positions + 3u * t[1],
+                                                             d->positions + 3u * t[2], wj);
+                if (!(dd <= reach * reach)) continue;
+                float dist = sqrtf(dd);
+                bool facing = normal_dir(d, t, wj, n1) && dot3(n0, n1) > 0.0f;
+                best[facing] = fminf(best[facing], dist);
+                uint32_t slot = nc;
+                if (nc == LOD_CHECK_NEAR) { /* full: the farthest kept gives way to a nearer one */
+                    slot = 0;
+                    for (uint32_t i = 1; i < nc; ++i)
+                        if (cand[i].dist > cand[slot].dist) slot = i;
+                    if (cand[slot].dist <= dist) continue;
+                } else
+                    nc++;
+                cand[slot].dist = dist, cand[slot].tri = list[j], cand[slot].facing = facing;
+                memcpy(cand[slot].w, wj, sizeof wj);
+            }
+            const int set = isfinite(best[1]) ? 1 : 0;
+            for (uint32_t i = 0; i < nc; ++i) {
+                if ((set == 1 && !cand[i].facing) || cand[i].dist > best[set] + tol) continue;
+                const uint32_t *t = level + 3u * cand[i].tri;
+                float n1[3], e = cand[i].dist, edge = 0.0f;
+                for (int k = 0; k < 3; ++k) {
+                    const float *pa = d->positions + 3u * t[k], *pb = d->positions + 3u * t[(k + 1) % 3];
+                    float v[3] = {pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]};
+                    edge = fmaxf(edge, sqrtf(dot3(v, v)));
+                }
+                if (normal_at(d, t, cand[i].w, n1)) e = fmaxf(e, acosf(fminf(fmaxf(dot3(n0, n1), -1.0f), 1.0f)) * 0.5f * edge);
+                if (s_uv > 0.0f) {
+                    float u0[2], u1[2];
+                    uv_at(d, o, w3, u0);
+                    uv_at(d, t, cand[i].w, u1);
+                    e = fmaxf(e, s_uv * sqrtf((u0[0] - u1[0]) * (u0[0] - u1[0]) + (u0[1] - u1[1]) * (u0[1] - u1[1])));
+                }
+                err = fminf(err, e);
+            }
+            if (!isfinite(err)) { /* no level triangle within reach: no bound */
+                sample_err = INFINITY;
+                break;
+            }
+            if (err > sample_err) sample_err = err;
+        }
+    }
+    free(start);
+    free(list);
+    return sample_err;
+}

@@ -4,6 +4,7 @@
 
 #include <meshoptimizer.h>
 #include <stb_image_resize.h>
+#include <xxhash.h>
 
 #include <math.h>
 #include <stdarg.h>
@@ -163,6 +164,11 @@ static void build_lods(const sy_gl_mesh_desc *d, mesh_o *m, uint32_t **out, size
             dev_abs = rel * scale;
         }
         if (n == 0 || n * 5u > prev_n * 4u) break;
+        /* the shading's deviation from the mesh too (a level in pieces: positions only; measuring
+         * 2^21 triangles and more would cost more than the simplification) */
+        float shading = d->triangle_count > LOD_PIECE_ABOVE ? 0.0f
+                      : sy_gli_level_shading_error(d, m->bmin, m->bmax, scratch, n / 3u, err_sum + dev_abs);
+        if (!isfinite(shading)) break;
         if (used + n > cap) {
             size_t ncap = used + n + n0 / 4u;
             uint32_t *grown = realloc(all, ncap * sizeof *all);
@@ -174,7 +180,7 @@ static void build_lods(const sy_gl_mesh_desc *d, mesh_o *m, uint32_t **out, size
         err_sum += dev_abs; /* deviation from the level before (meshoptimizer's relative error times the extent) */
         m->lod_first[k] = (uint32_t)(n0 + used);
         m->lod_tris[k] = (uint32_t)(n / 3u);
-        m->lod_error[k] = err_sum;
+        m->lod_error[k] = fmaxf(err_sum, shading);
         m->lod_count++;
         used += n;
     }
@@ -242,6 +248,92 @@ static void check_closed(const sy_gl_mesh_desc *d, mesh_o *m, const uint32_t *le
     }
     free(weld);
     free(table);
+}
+
+/* >>lod cache: what build_lods and check_closed made of a mesh, kept for the next identical one
+ * (positions, normals, uv0 and indices the same bits: every input of theirs). The key of a mesh
+ * the cache takes (indexed, with levels, at most LOD_CACHE_MAX_TRIANGLES), 0 for one it does not. */
+static uint64_t lod_cache_key(const sy_gl_mesh_desc *d)
+{
+    if (!d->indices || d->triangle_count < SY_GL_LOD_MIN_TRIANGLES || d->triangle_count > LOD_CACHE_MAX_TRIANGLES)
+        return 0;
+    XXH3_state_t *st = XXH3_createState();
+    if (!st) return 0;
+    XXH3_64bits_reset(st);
+    const uint32_t head[4] = {d->vertex_count, d->triangle_count, d->normals != NULL, d->uv[0] != NULL};
+    XXH3_64bits_update(st, head, sizeof head);
+    XXH3_64bits_update(st, d->positions, (size_t)d->vertex_count * 3 * sizeof(float));
+    if (d->normals) XXH3_64bits_update(st, d->normals, (size_t)d->vertex_count * 3 * sizeof(float));
+    if (d->uv[0]) XXH3_64bits_update(st, d->uv[0], (size_t)d->vertex_count * 2 * sizeof(float));
+    XXH3_64bits_update(st, d->indices, (size_t)d->triangle_count * 3 * sizeof(uint32_t));
+    uint64_t h = XXH3_64bits_digest(st);
+    XXH3_freeState(st);
+    return h ? h : 1;
+}
+
+/* The description of the levels (lod_count, lod_first, lod_tris, lod_error, lod_closed) from one
+ * mesh_o to another. */
+static void levels_copy(mesh_o *to, const mesh_o *from)
+{
+    to->lod_count = from->lod_count;
+    memcpy(to->lod_first, from->lod_first, sizeof to->lod_first);
+    memcpy(to->lod_tris, from->lod_tris, sizeof to->lod_tris);
+    memcpy(to->lod_error, from->lod_error, sizeof to->lod_error);
+    memcpy(to->lod_closed, from->lod_closed, sizeof to->lod_closed);
+}
+
+/* Whether the cache holds the levels of d (key: lod_cache_key): then m's lod_* and *out (a malloc'd
+ * copy), *count_out as build_lods gives them. */
+static bool lod_cache_take(sy_gl_device *dev, uint64_t key, const sy_gl_mesh_desc *d, mesh_o *m, uint32_t **out,
+                           size_t *count_out)
+{
+    if (!key) return false;
+    for (uint32_t i = 0; i < LOD_CACHE_ENTRIES; ++i) {
+        struct lod_cache_entry *e = &dev->lod_cache[i];
+        if (!e->used || e->hash != key || e->mesh.vertex_count != d->vertex_count ||
+            e->mesh.triangle_count != d->triangle_count) /* the counts too: another mesh's indices never */
+            continue;
+        uint32_t *copy = NULL;
+        if (e->level_indices && !(copy = malloc(e->level_indices * sizeof *copy))) return false;
+        if (copy) memcpy(copy, e->levels, e->level_indices * sizeof *copy);
+        levels_copy(m, &e->mesh);
+        *out = copy;
+        *count_out = 3u * (size_t)d->triangle_count + e->level_indices;
+        e->used = ++dev->lod_cache_clock;
+        return true;
+    }
+    return false;
+}
+
+/* Keeps m's levels (key: lod_cache_key of d; levels: build_lods' indices after level 0, count the
+ * buffer's indices) for the next identical mesh, in the least recently used entry; nothing without
+ * memory. */
+static void lod_cache_put(sy_gl_device *dev, uint64_t key, const sy_gl_mesh_desc *d, const mesh_o *m,
+                          const uint32_t *levels, size_t count)
+{
+    if (!key) return;
+    struct lod_cache_entry *e = &dev->lod_cache[0];
+    for (uint32_t i = 1; i < LOD_CACHE_ENTRIES; ++i)
+        if (dev->lod_cache[i].used < e->used) e = &dev->lod_cache[i];
+    size_t n = count - 3u * (size_t)d->triangle_count;
+    uint32_t *copy = n ? malloc(n * sizeof *copy) : NULL;
+    if (n && !copy) return;
+    if (copy) memcpy(copy, levels, n * sizeof *copy);
+    free(e->levels);
+    e->levels = copy;
+    e->level_indices = n;
+    e->hash = key;
+    e->mesh.vertex_count = d->vertex_count, e->mesh.triangle_count = d->triangle_count;
+    levels_copy(&e->mesh, m);
+    e->used = ++dev->lod_cache_clock;
+}
+
+void sy_gli_lod_cache_free(sy_gl_device *dev)
+{
+    for (uint32_t i = 0; i < LOD_CACHE_ENTRIES; ++i) {
+        free(dev->lod_cache[i].levels);
+        memset(&dev->lod_cache[i], 0, sizeof dev->lod_cache[i]);
+    }
 }
 
 /* The mesh's box, and the sphere around it that culling and levels of detail use. */
@@ -372,8 +464,12 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
     set_bounds(m, bmin, bmax);
     uint32_t *lods = NULL;
     size_t index_count = 0;
-    build_lods(d, m, &lods, &index_count);
-    check_closed(d, m, lods);
+    const uint64_t key = lod_cache_key(d);
+    if (!lod_cache_take(dev, key, d, m, &lods, &index_count)) {
+        build_lods(d, m, &lods, &index_count);
+        check_closed(d, m, lods);
+        lod_cache_put(dev, key, d, m, lods, index_count);
+    }
     uint32_t *where = NULL; /* with m->order: a mesh vertex's buffer position */
     if (lods && d->vertex_count >= LOD_REORDER_VERTICES && level_vertex_order(d, m, lods, &m->order, &where))
         for (size_t i = 0; i < index_count - 3u * (size_t)d->triangle_count; ++i) lods[i] = where[lods[i]];
