@@ -170,13 +170,28 @@ static float box_nearest_depth(const view_setup *v, const float box[8][3])
     return isfinite(nearest) && nearest > 0.0f ? nearest : 0.0f;
 }
 
-/* The coarsest level whose deviation, at px_per_m pixels per world unit, is within the budget. */
-static uint32_t level_for(const sy_gl_device *dev, const mesh_o *m, float scale, float px_per_m)
+/* The coarsest level whose deviation (err: m->lod_error or m->lod_error_uv), at px_per_m pixels per
+ * world unit, is within the budget. */
+static uint32_t level_for(const sy_gl_device *dev, const mesh_o *m, const float *err, float scale, float px_per_m)
 {
     uint32_t lod = 0;
     if (!(px_per_m > 0.0f)) return 0;
-    while (lod + 1 < m->lod_count && m->lod_error[lod + 1] * scale * px_per_m <= dev->lod_pixels) ++lod;
+    while (lod + 1 < m->lod_count && err[lod + 1] * scale * px_per_m <= dev->lod_pixels) ++lod;
     return lod;
+}
+
+/* Whether instance in's material samples a texture (its uv0's slide shows). */
+static bool textured(const sy_gl_device *dev, const inst_o *in)
+{
+    const mat_o *mt = sy_gli_pool_get(&dev->materials, in->material.id);
+    if (!mt) return false;
+    const sy_gl_texture_ref *refs[5 + LAYER_TEXTURES] = {&mt->d.base_color_texture, &mt->d.metallic_roughness_texture,
+                                                         &mt->d.normal_texture, &mt->d.occlusion_texture,
+                                                         &mt->d.emissive_texture};
+    sy_gli_layer_refs(&mt->d, refs + 5);
+    for (int i = 0; i < 5 + LAYER_TEXTURES; ++i)
+        if (sy_gli_pool_get(&dev->textures, refs[i]->texture.id)) return true;
+    return false;
 }
 
 /* The sphere's nearest depth first (cheap); where that leaves a finer level than the coarsest, the
@@ -187,13 +202,14 @@ uint32_t sy_gli_choose_lod(const sy_gl_device *dev, const inst_o *in, const mesh
                            const float c[3], float r, float scale)
 {
     if (m->lod_count < 2 || dev->lod_pixels <= 0.0f) return 0;
-    uint32_t lod = level_for(dev, m, scale, sy_gli_sphere_px_per_unit(v, c, r));
+    const float *err = textured(dev, in) ? m->lod_error_uv : m->lod_error;
+    uint32_t lod = level_for(dev, m, err, scale, sy_gli_sphere_px_per_unit(v, c, r));
     if (lod + 1 < m->lod_count && !v->ortho && v->bounds_ok && v->ppu > 0.0f) {
         float box[8][3];
         sy_gli_instance_box(in, m, box);
         float d = box_nearest_depth(v, box);
         if (d > 0.0f) {
-            uint32_t l2 = level_for(dev, m, scale, v->ppu / d);
+            uint32_t l2 = level_for(dev, m, err, scale, v->ppu / d);
             if (l2 > lod) lod = l2;
         }
     }
@@ -278,6 +294,8 @@ static bool normal_at(const sy_gl_mesh_desc *d, const uint32_t *t, const float w
     return true;
 }
 
+static float angle_between(const float a[3], const float b[3]) { return acosf(fminf(fmaxf(dot3(a, b), -1.0f), 1.0f)); }
+
 static void uv_at(const sy_gl_mesh_desc *d, const uint32_t *t, const float w[3], float uv[2])
 {
     for (int k = 0; k < 2; ++k) uv[k] = w[0] * d->uv[0][2u * t[0] + k] + w[1] * d->uv[0][2u * t[1] + k] + w[2] * d->uv[0][2u * t[2] + k];
@@ -297,9 +315,36 @@ static float metres_per_uv(const sy_gl_mesh_desc *d, const uint32_t *t)
     return isfinite(r) ? r : 0.0f;
 }
 
-float sy_gli_level_shading_error(const sy_gl_mesh_desc *d, const float bmin[3], const float bmax[3], const uint32_t *level,
-                                 size_t tris, float tol)
+bool sy_gli_normals_beyond_geometry(const sy_gl_mesh_desc *d)
 {
+    if (!d->normals || !d->indices) return false;
+    float *acc = calloc((size_t)d->vertex_count * 3, sizeof *acc);
+    if (!acc) return true; /* without memory: counted, the safe side */
+    for (size_t t = 0; t < d->triangle_count; ++t) { /* area-weighted face normals at each vertex index */
+        const uint32_t *i = d->indices + 3 * t;
+        const float *a = d->positions + 3u * i[0], *b = d->positions + 3u * i[1], *c = d->positions + 3u * i[2];
+        float e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        float n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+        for (int k = 0; k < 3; ++k)
+            for (int j = 0; j < 3; ++j) acc[3u * i[k] + j] += n[j];
+    }
+    size_t off = 0, used = 0;
+    for (size_t v = 0; v < d->vertex_count; ++v) {
+        float *g = acc + 3 * v, l = sqrtf(dot3(g, g));
+        const float *n = d->normals + 3 * v;
+        float ln = sqrtf(dot3(n, n));
+        if (!(l > 0.0f) || !(ln > 0.0f) || !isfinite(l) || !isfinite(ln)) continue;
+        used++;
+        off += dot3(g, n) < cosf(LOD_NORMAL_TURN) * l * ln;
+    }
+    free(acc);
+    return off * 100u > used; /* more than 1 % of the vertices */
+}
+
+float sy_gli_level_shading_error(const sy_gl_mesh_desc *d, const float bmin[3], const float bmax[3], const uint32_t *level,
+                                 size_t tris, float tol, bool normals_count, float *with_uv)
+{
+    *with_uv = INFINITY;
     if (!d->indices || !tris) return INFINITY;
     /* the grid: cubes of about four of the level's triangles' area each (surfaces are two-dimensional),
      * at most LOD_CHECK_CELLS of them */
@@ -367,6 +412,7 @@ float sy_gli_level_shading_error(const sy_gl_mesh_desc *d, const float bmin[3], 
          * runs of the index list (a fixed stride fell on the same columns of every row of a grid) */
         const size_t n_all = d->triangle_count, n_s = n_all > LOD_CHECK_SAMPLES ? LOD_CHECK_SAMPLES : n_all;
         sample_err = 0.0f;
+        float uv_err = 0.0f;
         for (size_t i = 0; i < n_s && isfinite(sample_err); ++i) {
             size_t s = i;
             if (n_s < n_all) {
@@ -394,7 +440,7 @@ float sy_gli_level_shading_error(const sy_gl_mesh_desc *d, const float bmin[3], 
              * farthest) and then weighed. */
             struct { float dist, w[3]; uint32_t tri; bool facing; } cand[LOD_CHECK_NEAR];
             uint32_t nc = 0;
-            float best[2] = {INFINITY, INFINITY}, err = INFINITY;
+            float best[2] = {INFINITY, INFINITY}, err = INFINITY, err_uv = INFINITY;
             for (uint32_t j = start[c]; j < start[c + 1]; ++j) {
                 const uint32_t *t = level + 3u * list[j];
                 float wj[3], n1[3], dd = closest_on_triangle(p, d->positions + 3u * t[0], d->positions + 3u * t[1],
@@ -424,21 +470,24 @@ float sy_gli_level_shading_error(const sy_gl_mesh_desc *d, const float bmin[3], 
                     float v[3] = {pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]};
                     edge = fmaxf(edge, sqrtf(dot3(v, v)));
                 }
-                if (normal_at(d, t, cand[i].w, n1)) e = fmaxf(e, acosf(fminf(fmaxf(dot3(n0, n1), -1.0f), 1.0f)) * 0.5f * edge);
+                if (normals_count && normal_at(d, t, cand[i].w, n1)) e = fmaxf(e, angle_between(n0, n1) * 0.5f * edge);
+                float eu = e;
                 if (s_uv > 0.0f) {
                     float u0[2], u1[2];
                     uv_at(d, o, w3, u0);
                     uv_at(d, t, cand[i].w, u1);
-                    e = fmaxf(e, s_uv * sqrtf((u0[0] - u1[0]) * (u0[0] - u1[0]) + (u0[1] - u1[1]) * (u0[1] - u1[1])));
+                    eu = fmaxf(e, s_uv * sqrtf((u0[0] - u1[0]) * (u0[0] - u1[0]) + (u0[1] - u1[1]) * (u0[1] - u1[1])));
                 }
-                err = fminf(err, e);
+                err = fminf(err, e), err_uv = fminf(err_uv, eu);
             }
             if (!isfinite(err)) { /* no level triangle within reach: no bound */
                 sample_err = INFINITY;
                 break;
             }
             if (err > sample_err) sample_err = err;
+            if (err_uv > uv_err) uv_err = err_uv;
         }
+        if (isfinite(sample_err)) *with_uv = uv_err;
     }
     free(start);
     free(list);

@@ -135,7 +135,7 @@ static void build_lods(const sy_gl_mesh_desc *d, mesh_o *m, uint32_t **out, size
     m->lod_count = 1;
     m->lod_first[0] = 0;
     m->lod_tris[0] = d->triangle_count;
-    m->lod_error[0] = 0.0f;
+    m->lod_error[0] = m->lod_error_uv[0] = 0.0f;
     *out = NULL;
     *count_out = n0;
     if (!d->indices || d->triangle_count < SY_GL_LOD_MIN_TRIANGLES) return;
@@ -148,6 +148,7 @@ static void build_lods(const sy_gl_mesh_desc *d, mesh_o *m, uint32_t **out, size
         return;
     }
     float scale = meshopt_simplifyScale(d->positions, d->vertex_count, 3 * sizeof(float)), err_sum = 0.0f;
+    const bool custom_normals = d->triangle_count <= LOD_PIECE_ABOVE && sy_gli_normals_beyond_geometry(d);
     while (m->lod_count < LOD_MAX) {
         uint32_t k = m->lod_count;
         size_t prev_n = 3u * (size_t)m->lod_tris[k - 1], target = prev_n / 4u / 3u * 3u;
@@ -166,8 +167,10 @@ static void build_lods(const sy_gl_mesh_desc *d, mesh_o *m, uint32_t **out, size
         if (n == 0 || n * 5u > prev_n * 4u) break;
         /* the shading's deviation from the mesh too (a level in pieces: positions only; measuring
          * 2^21 triangles and more would cost more than the simplification) */
+        float with_uv = 0.0f;
         float shading = d->triangle_count > LOD_PIECE_ABOVE ? 0.0f
-                      : sy_gli_level_shading_error(d, m->bmin, m->bmax, scratch, n / 3u, err_sum + dev_abs);
+                      : sy_gli_level_shading_error(d, m->bmin, m->bmax, scratch, n / 3u, err_sum + dev_abs, custom_normals,
+                                                   &with_uv);
         if (!isfinite(shading)) break;
         if (used + n > cap) {
             size_t ncap = used + n + n0 / 4u;
@@ -181,6 +184,7 @@ static void build_lods(const sy_gl_mesh_desc *d, mesh_o *m, uint32_t **out, size
         m->lod_first[k] = (uint32_t)(n0 + used);
         m->lod_tris[k] = (uint32_t)(n / 3u);
         m->lod_error[k] = fmaxf(err_sum, shading);
+        m->lod_error_uv[k] = fmaxf(m->lod_error[k], with_uv);
         m->lod_count++;
         used += n;
     }
@@ -271,7 +275,7 @@ static uint64_t lod_cache_key(const sy_gl_mesh_desc *d)
     return h ? h : 1;
 }
 
-/* The description of the levels (lod_count, lod_first, lod_tris, lod_error, lod_closed) from one
+/* The description of the levels (lod_count, lod_first, lod_tris, lod_error(_uv), lod_closed) from one
  * mesh_o to another. */
 static void levels_copy(mesh_o *to, const mesh_o *from)
 {
@@ -279,6 +283,7 @@ static void levels_copy(mesh_o *to, const mesh_o *from)
     memcpy(to->lod_first, from->lod_first, sizeof to->lod_first);
     memcpy(to->lod_tris, from->lod_tris, sizeof to->lod_tris);
     memcpy(to->lod_error, from->lod_error, sizeof to->lod_error);
+    memcpy(to->lod_error_uv, from->lod_error_uv, sizeof to->lod_error_uv);
     memcpy(to->lod_closed, from->lod_closed, sizeof to->lod_closed);
 }
 
