@@ -5,8 +5,8 @@
  *   (sy_gl_context.c, below them all: the GL context and the error report, sy_gli_fail)
  *   sy_gl_base.c     pools, warnings, math, frustum tests, GL checks
  *   sy_gl_programs.c stand-in textures, material blocks, shader variants, the material table
+ *   sy_gl_lod.c      levels of detail: their deviation measured, the level chosen per view, its draw
  *   sy_gl_objects.c  meshes (levels of detail), textures, materials, instances, lights, environment
- *   sy_gl_lod.c      levels of detail chosen per view, drawing one level
  *   sy_gl_shadows.c  the lights' uniform blocks and shadow maps
  *   sy_gl_draw.c     targets, views, the forward and deferred passes, culling, MSAA resolve
  *   sy_gl_render.c   scene probes and the frame (sy_gl_render, sy_gl_render_floor)

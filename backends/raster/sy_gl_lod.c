@@ -1,5 +1,6 @@
-/* sy_gl_lod.c — levels of detail per view: the level each instance draws (its projected size
- * against the mesh's simplification error) and the draw of one level. */
+/* sy_gl_lod.c — levels of detail: the deviation of a simplified level from its mesh, measured when
+ * the mesh is made (sy_gl_objects.c builds the levels), the level each instance draws per view (its
+ * projected size against that deviation) and the draw of one level. */
 #include "sy_gl_internal.h"
 
 #include <math.h>
