@@ -270,6 +270,14 @@ static float closest_on_triangle(const float p[3], const float a[3], const float
     return dd;
 }
 
+/* (b - a) x (c - a) of triangle t of d: its face normal times twice its area. */
+static void tri_cross(const sy_gl_mesh_desc *d, const uint32_t *t, float n[3])
+{
+    const float *a = d->positions + 3u * t[0], *b = d->positions + 3u * t[1], *c = d->positions + 3u * t[2];
+    float e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1], n[1] = e1[2] * e2[0] - e1[0] * e2[2], n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+}
+
 /* The normal of triangle t at weights w, not normalised: its vertex normals interpolated, or its
  * face normal when the mesh has none (the rasterizer's flat normals); false when it has no
  * direction. normal_at: the same, of unit length. */
@@ -278,11 +286,8 @@ static bool normal_dir(const sy_gl_mesh_desc *d, const uint32_t *t, const float 
     if (d->normals) {
         for (int k = 0; k < 3; ++k)
             n[k] = w[0] * d->normals[3u * t[0] + k] + w[1] * d->normals[3u * t[1] + k] + w[2] * d->normals[3u * t[2] + k];
-    } else {
-        const float *a = d->positions + 3u * t[0], *b = d->positions + 3u * t[1], *c = d->positions + 3u * t[2];
-        float e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-        n[0] = e1[1] * e2[2] - e1[2] * e2[1], n[1] = e1[2] * e2[0] - e1[0] * e2[2], n[2] = e1[0] * e2[1] - e1[1] * e2[0];
-    }
+    } else
+        tri_cross(d, t, n);
     float l2 = dot3(n, n);
     return l2 > 0.0f && isfinite(l2);
 }
@@ -307,11 +312,10 @@ static void uv_at(const sy_gl_mesh_desc *d, const uint32_t *t, const float w[3],
 static float metres_per_uv(const sy_gl_mesh_desc *d, const uint32_t *t)
 {
     if (!d->uv[0]) return 0.0f;
-    const float *a = d->positions + 3u * t[0], *b = d->positions + 3u * t[1], *c = d->positions + 3u * t[2];
-    float e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    float x = e1[1] * e2[2] - e1[2] * e2[1], y = e1[2] * e2[0] - e1[0] * e2[2], z = e1[0] * e2[1] - e1[1] * e2[0];
+    float n[3];
+    tri_cross(d, t, n);
     const float *u0 = d->uv[0] + 2u * t[0], *u1 = d->uv[0] + 2u * t[1], *u2 = d->uv[0] + 2u * t[2];
-    float aw = sqrtf(x * x + y * y + z * z), au = fabsf((u1[0] - u0[0]) * (u2[1] - u0[1]) - (u1[1] - u0[1]) * (u2[0] - u0[0]));
+    float aw = sqrtf(dot3(n, n)), au = fabsf((u1[0] - u0[0]) * (u2[1] - u0[1]) - (u1[1] - u0[1]) * (u2[0] - u0[0]));
     float r = aw > 0.0f && au > 0.0f ? sqrtf(aw / au) : 0.0f;
     return isfinite(r) ? r : 0.0f;
 }
@@ -323,9 +327,8 @@ bool sy_gli_normals_beyond_geometry(const sy_gl_mesh_desc *d)
     if (!acc) return true; /* without memory: counted, the safe side */
     for (size_t t = 0; t < d->triangle_count; ++t) { /* area-weighted face normals at each vertex index */
         const uint32_t *i = d->indices + 3 * t;
-        const float *a = d->positions + 3u * i[0], *b = d->positions + 3u * i[1], *c = d->positions + 3u * i[2];
-        float e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-        float n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+        float n[3];
+        tri_cross(d, i, n);
         for (int k = 0; k < 3; ++k)
             for (int j = 0; j < 3; ++j) acc[3u * i[k] + j] += n[j];
     }
@@ -356,10 +359,7 @@ float sy_gli_level_shading_error(const sy_gl_mesh_desc *d, const float bmin[3], 
     if (!(ext > 0.0f)) return 0.0f;
     for (size_t t = 0; t < tris; ++t) {
         float n[3];
-        const uint32_t *i = level + 3 * t;
-        const float *a = d->positions + 3u * i[0], *b = d->positions + 3u * i[1], *c = d->positions + 3u * i[2];
-        float e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-        n[0] = e1[1] * e2[2] - e1[2] * e2[1], n[1] = e1[2] * e2[0] - e1[0] * e2[2], n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        tri_cross(d, level + 3 * t, n);
         area += 0.5 * sqrt((double)dot3(n, n));
     }
     float cell = (float)sqrt(4.0 * area / (double)tris);
