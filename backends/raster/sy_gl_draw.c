@@ -431,15 +431,7 @@ static int material_features(const sy_gl_device *dev, const mat_o *mt)
  * features draws every material, and reads the textures its block names. */
 static uint32_t texture_features(const sy_gl_device *dev, const mat_o *mt)
 {
-    uint32_t s = 0;
-    const sy_gl_texture_ref *lr[LAYER_TEXTURES];
-    sy_gli_layer_refs(&mt->d, lr);
-    for (int i = 0; i < LAYER_TEXTURES && dev->layer_units; ++i)
-        if (sy_gli_pool_get(&dev->textures, lr[i]->texture.id)) s |= 1u << i;
-    const sy_gl_texture_ref *refs[5] = {&mt->d.base_color_texture, &mt->d.metallic_roughness_texture,
-                                        &mt->d.normal_texture, &mt->d.occlusion_texture, &mt->d.emissive_texture};
-    for (int i = 0; i < 5; ++i)
-        if (sy_gli_pool_get(&dev->textures, refs[i]->texture.id)) s |= 1u << (MSIG_BASE_SHIFT + i);
+    uint32_t s = sy_gli_material_textures(dev, mt);
     if (mt->d.iridescence > 0.0f) s |= MSIG_IRID;
     if (mt->d.anisotropy > 0.0f) s |= MSIG_ANISO;
     return s;

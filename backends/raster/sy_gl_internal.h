@@ -53,6 +53,14 @@ static inline void sy_gli_layer_refs(const sy_gl_material_desc *d, const sy_gl_t
     r[6] = &d->sheen_roughness_texture, r[7] = &d->thickness_texture, r[8] = &d->anisotropy_texture;
     r[9] = &d->iridescence_texture, r[10] = &d->iridescence_thickness_texture, r[11] = &d->transmission_texture;
 }
+/* Every texture slot of a material: the five base ones (UNIT_BASE .. UNIT_EMIS), then the layers'
+ * (sy_gli_layer_refs). */
+static inline void sy_gli_material_refs(const sy_gl_material_desc *d, const sy_gl_texture_ref *r[STANDINS])
+{
+    r[0] = &d->base_color_texture, r[1] = &d->metallic_roughness_texture, r[2] = &d->normal_texture;
+    r[3] = &d->occlusion_texture, r[4] = &d->emissive_texture;
+    sy_gli_layer_refs(d, r + 5);
+}
 /* Scene probes: mirror-like and glass instances see the scene, not only the environment. Each of
  * the first SY_GL_MAX_PROBES such instances gets a cube map rendered from its bounding-box centre
  * (the instance itself left out, other probed instances showing the environment), with a mip
@@ -432,6 +440,9 @@ float sy_gli_world_sphere(const inst_o *in, const mesh_o *m, float c[3], float *
 bool sy_gli_sphere_outside(const float planes[6][4], const float c[3], float r);
 
 /* sy_gl_programs.c */
+/* The texture slots material mt samples, as bits of dev->material_sig: layer slot k bit k (none
+ * without dev->layer_units: the layers' units are not read then), base slot k bit MSIG_BASE_SHIFT + k. */
+uint32_t sy_gli_material_textures(const sy_gl_device *dev, const mat_o *mt);
 /* The name of main variant v under the lights' current signature ("main TEX LIGHTS ... (2 lights: ...)"). */
 void sy_gli_variant_name(const sy_gl_device *dev, int v, char *name, size_t len);
 /* A stand-in's sampling, as llvmpipe's shader key sees it: bits 0-1 the texel format (0 RGBA8,

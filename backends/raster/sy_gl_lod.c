@@ -185,14 +185,7 @@ static uint32_t level_for(const sy_gl_device *dev, const mesh_o *m, const float 
 static bool textured(const sy_gl_device *dev, const inst_o *in)
 {
     const mat_o *mt = sy_gli_pool_get(&dev->materials, in->material.id);
-    if (!mt) return false;
-    const sy_gl_texture_ref *refs[5 + LAYER_TEXTURES] = {&mt->d.base_color_texture, &mt->d.metallic_roughness_texture,
-                                                         &mt->d.normal_texture, &mt->d.occlusion_texture,
-                                                         &mt->d.emissive_texture};
-    sy_gli_layer_refs(&mt->d, refs + 5);
-    for (int i = 0; i < 5 + LAYER_TEXTURES; ++i)
-        if (sy_gli_pool_get(&dev->textures, refs[i]->texture.id)) return true;
-    return false;
+    return mt && sy_gli_material_textures(dev, mt) != 0;
 }
 
 /* The sphere's nearest depth first (cheap); where that leaves a finer level than the coarsest, the

@@ -875,10 +875,9 @@ static sy_gl_result material_check(const sy_gl_material_desc *d, sy_gl_report *r
         if (!isfinite(*v[i])) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "material: parameter %zu is not finite", i);
     if ((unsigned)d->alpha_mode > 2u)
         return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "material: unknown alpha mode %d", (int)d->alpha_mode);
-    const sy_gl_texture_ref *refs[5 + LAYER_TEXTURES] = {&d->base_color_texture, &d->metallic_roughness_texture,
-                                                         &d->normal_texture, &d->occlusion_texture, &d->emissive_texture};
-    sy_gli_layer_refs(d, refs + 5);
-    for (int i = 0; i < 5 + LAYER_TEXTURES; ++i)
+    const sy_gl_texture_ref *refs[STANDINS];
+    sy_gli_material_refs(d, refs);
+    for (int i = 0; i < STANDINS; ++i)
         for (int k = 0; refs[i]->transformed && k < 6; ++k)
             if (!isfinite(refs[i]->transform[k]))
                 return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, "material: texture %d transform[%d] is not finite", i, k);

@@ -70,9 +70,8 @@ void sy_gli_standins_make(sy_gl_device *dev)
 
 void sy_gli_standins_want(const sy_gl_device *dev, const mat_o *m, uint32_t want[STANDINS])
 {
-    const sy_gl_texture_ref *refs[STANDINS] = {&m->d.base_color_texture, &m->d.metallic_roughness_texture,
-                                               &m->d.normal_texture, &m->d.occlusion_texture, &m->d.emissive_texture};
-    sy_gli_layer_refs(&m->d, refs + 5);
+    const sy_gl_texture_ref *refs[STANDINS];
+    sy_gli_material_refs(&m->d, refs);
     for (int i = 0; i < (dev->layer_units ? STANDINS : 5); ++i) {
         if (want[i] != STANDIN_ANY) continue;
         const tex_o *t = sy_gli_pool_get(&dev->textures, refs[i]->texture.id);
@@ -90,6 +89,16 @@ void sy_gli_standins_follow(sy_gl_device *dev, const uint32_t want[STANDINS])
         dev->standin[i] = sy_gli_make_standin(dev->gl, rgba, key);
         dev->standin_key[i] = key;
     }
+}
+
+uint32_t sy_gli_material_textures(const sy_gl_device *dev, const mat_o *mt)
+{
+    const sy_gl_texture_ref *refs[STANDINS];
+    sy_gli_material_refs(&mt->d, refs);
+    uint32_t s = 0;
+    for (int i = 0; i < (dev->layer_units ? STANDINS : 5); ++i)
+        if (sy_gli_pool_get(&dev->textures, refs[i]->texture.id)) s |= i < 5 ? 1u << (MSIG_BASE_SHIFT + i) : 1u << (i - 5);
+    return s;
 }
 
 void sy_gli_material_block(const sy_gl_device *dev, const sy_gl_material_desc *d, mat_block *b)
@@ -351,10 +360,8 @@ void sy_gli_profile_draw(const sy_gl_device *dev, double t0, const char *what)
     char tex[512] = "";
     const mat_o *m = dev->profile_var >= 0 ? sy_gli_pool_get(&dev->materials, dev->profile_mat) : NULL;
     if (m) { /* what the material's texture units sample: llvmpipe's shader key holds their sampling */
-        const sy_gl_texture_ref *refs[5 + LAYER_TEXTURES] = {&m->d.base_color_texture, &m->d.metallic_roughness_texture,
-                                                             &m->d.normal_texture, &m->d.occlusion_texture,
-                                                             &m->d.emissive_texture};
-        sy_gli_layer_refs(&m->d, refs + 5);
+        const sy_gl_texture_ref *refs[STANDINS];
+        sy_gli_material_refs(&m->d, refs);
         size_t n = 0;
         for (int i = 0; i < 5 + LAYER_TEXTURES && n < sizeof tex; ++i) {
             const tex_o *t = sy_gli_pool_get(&dev->textures, refs[i]->texture.id);
