@@ -448,7 +448,7 @@ static uint32_t texture_features(const sy_gl_device *dev, const mat_o *mt)
 void sy_gli_frame_features(sy_gl_device *dev)
 {
     int shared = 0;
-    bool full = false;
+    bool full = false, masked = false;
     uint32_t want[STANDINS], material_sig = 0;
     for (int k = 0; k < STANDINS; ++k) want[k] = STANDIN_ANY;
     const mat_o *last = NULL;
@@ -458,6 +458,7 @@ void sy_gli_frame_features(sy_gl_device *dev)
         const mat_o *mt = sy_gli_pool_get(&dev->materials, in->material.id);
         if (mt && mt != last) {
             shared |= material_features(dev, last = mt);
+            masked |= mt->d.alpha_mode == SY_GL_ALPHA_MASK;
             material_sig |= texture_features(dev, mt);
             sy_gli_standins_want(dev, mt, want);
         }
@@ -466,6 +467,7 @@ void sy_gli_frame_features(sy_gl_device *dev)
     }
     dev->shared_features = shared;
     dev->shared_full = full;
+    dev->shared_masked = masked;
     dev->material_sig = material_sig;
     sy_gli_standins_follow(dev, want);
 }
@@ -652,6 +654,11 @@ static sy_gl_result draw_instance(sy_gl_device *dev, draw_ctx *dc, uint32_t inde
      * of its own reads the environment through the probe's unit (sy_gli_draw_scene; issue 32: 8.7 ->
      * 5.3 s cold at 200x150 on llvmpipe, 1.7 -> 1.8 s warm). */
     pv = sy_gli_variant_normalize((pv | dc->shared) & ~(dev->shared_full ? VAR_LEAN : 0));
+    /* probe faces: one program for masked and other materials (those discard nothing: cutoff 0 in
+     * their block), so llvmpipe compiles one for the probes, not two (0.3-0.45 s each for
+     * TransmissionTest's; issue 32); a face of 16-256 texels loses little to the late depth test
+     * that discard brings */
+    if (dev->in_probe_pass && dev->shared_masked) pv |= VAR_MASK;
     /* probe faces (16-256 px, seen blurred) shade without normal maps and material layers: a
      * smaller program that llvmpipe compiles in about half the time (docs/BACKENDS.md) */
     if (dev->in_probe_pass) pv = sy_gli_variant_normalize(pv & ~(VAR_NMAP | VAR_LAYERS));

@@ -334,6 +334,7 @@ struct sy_gl_device {
     size_t scratch_len;
     int shared_features; /* material_features of every visible instance (sy_gli_frame_features) */
     bool shared_full;    /* a visible mesh is not VAR_LEAN: no forward draw is (sy_gli_frame_features) */
+    bool shared_masked;  /* a visible instance's material is masked (sy_gli_frame_features) */
     /* sy_gli_frame_features: the texture slots some visible material samples (bit k < LAYER_TEXTURES:
      * layer slot k of sy_gli_layer_refs; bit MSIG_BASE_SHIFT + k: base slot k, UNIT_BASE ..
      * UNIT_EMIS), MSIG_IRID one has iridescence, MSIG_ANISO one anisotropy; the programs that read

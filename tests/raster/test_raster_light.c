@@ -7,7 +7,8 @@
  *  2. a mirror (metallic 1, roughness 0) under a lat-long environment whose upper half is 2 and lower
  *     half 0.5 reflects one half or the other, not their mean (the prefiltered mip 0 is sharp);
  *     without an environment it reflects the scene around it (an emissive ceiling; its scene
- *     probe), and hiding the ceiling updates the reflection;
+ *     probe), also when an alpha-masked instance makes the probe faces draw with the masked
+ *     program, and hiding the ceiling updates the reflection;
  *  3. a square emitter above a Lambert floor: the irradiance under its centre matches the form
  *     factor of a square (LTC, diffuse), the emitter does not light points behind it (one-sided),
  *     a double-sided emitter lights both sides, an occluder casts a shadow; a point light's cube
@@ -166,6 +167,7 @@ int main(int argc, char **argv)
         gd.base_color[0] = gd.base_color[1] = gd.base_color[2] = 0.0f;
         gd.emissive[1] = 4.0f;
         gd.double_sided = true;
+        gd.base_color[3] = 0.3f; /* opaque: alpha is not coverage (and below the default cutoff, 0.5) */
         sy_gl_material gm;
         MUST(sy_gl_material_create(d, &gd, &gm));
         const float ceiling[12] = {-4, 3, 1, 4, 3, 1, 4, 3, -8, -4, 3, -8};
@@ -175,6 +177,28 @@ int main(int argc, char **argv)
         printf("mirror under a green ceiling %g %g (want 0 4)\n", px(16, 16)[0], px(16, 16)[1]);
         EXPECT_MSG(near_(px(16, 16)[1], 4.0f, 0.03f) && px(16, 16)[0] < 0.01f, "mirror reflects the ceiling: %g %g (want 0 4)",
                    px(16, 16)[0], px(16, 16)[1]);
+        /* with an alpha-masked instance in the scene (far below, out of the mirror's sight) the
+         * probe faces draw every material with the masked program (one compile on llvmpipe, not
+         * two); the ceiling is opaque and stays in the reflection (it was discarded: its alpha 0.3
+         * under the masked program's cutoff) */
+        {
+            sy_gl_material_desc kd;
+            sy_gl_material_desc_init(&kd);
+            kd.alpha_mode = SY_GL_ALPHA_MASK;
+            kd.alpha_cutoff = 0.5f;
+            sy_gl_material km;
+            MUST(sy_gl_material_create(d, &kd, &km));
+            const float below[12] = {-1, -40, 1, 1, -40, 1, 1, -40, -1, -1, -40, -1};
+            const float up[3] = {0, 1, 0};
+            sy_gl_instance ki = gl_test_place(d, quad(d, below, up), km);
+            MUST(sy_gl_render(d, &cam, &full, rgba, depth));
+            printf("mirror under a green ceiling, a masked instance in the scene %g %g (want 0 4)\n", px(16, 16)[0],
+                   px(16, 16)[1]);
+            EXPECT_MSG(near_(px(16, 16)[1], 4.0f, 0.03f) && px(16, 16)[0] < 0.01f,
+                       "with a masked instance in the scene the mirror lost the ceiling: %g %g (want 0 4)", px(16, 16)[0],
+                       px(16, 16)[1]);
+            MUST(sy_gl_instance_destroy(d, ki));
+        }
         /* the same quad as clear glass (no environment either): its Fresnel reflection and
          * refraction see the ceiling through the probe too */
         sy_gl_material_desc glass;
