@@ -52,6 +52,32 @@ void sy_mirror_flat_texture_mean(const sy_mirror_flat_texture *t, float mean[3])
     for (int c = 0; c < 3; ++c) mean[c] = n ? (float)(sum[c] / (double)n) : 0.0f;
 }
 
+void sy_mirror_flat_texture_blocks(const sy_mirror_flat_texture *t, uint32_t gw, uint32_t gh, float *out)
+{
+    const size_t ch = t->channels, w = t->width, h = t->height;
+    float lut[256]; /* 8-bit codes decoded once */
+    for (int v = 0; v < 256; ++v) lut[v] = t->format == SY_MIRROR_FLAT_UNORM8_SRGB ? sy_srgb_decode(v / 255.0f) : v / 255.0f;
+    for (uint32_t j = 0; j < gh; ++j) {
+        const size_t y0 = j * h / gh, y1 = (j + 1u) * h / gh;
+        for (uint32_t i = 0; i < gw; ++i) {
+            const size_t x0 = i * w / gw, x1 = (i + 1u) * w / gw;
+            double sum[3] = {0, 0, 0};
+            size_t n = 0;
+            for (size_t y = y0; y < y1; ++y)
+                for (size_t x = x0; x < x1; ++x, ++n) {
+                    const size_t o = (y * w + x) * ch;
+                    for (size_t c = 0; c < 3; ++c) {
+                        const size_t k = o + (ch <= 2 ? 0 : c);
+                        float v = t->format == SY_MIRROR_FLAT_FLOAT32 ? ((const float *)t->pixels)[k]
+                                                                      : lut[((const unsigned char *)t->pixels)[k]];
+                        if (isfinite(v)) sum[c] += v;
+                    }
+                }
+            for (int c = 0; c < 3; ++c) out[3 * ((size_t)j * gw + i) + (size_t)c] = n ? (float)(sum[c] / (double)n) : 0.0f;
+        }
+    }
+}
+
 /* A factor the specifications bound to [0, 1] (core accepts any non-negative value). */
 static float unit(float x) { return x < 0.0f ? 0.0f : x > 1.0f ? 1.0f : x; }
 

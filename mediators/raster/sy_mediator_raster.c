@@ -9,7 +9,10 @@
  *    the world transform; double-sided emitters emit from both faces), merging two consecutive
  *    coplanar triangles that share an edge into a convex quad (the Cornell ceiling panel is one
  *    quad);
- *  - textured emission uses the factor x the texture's mean (computed once per texture);
+ *  - textured emission: each triangle lights with the factor x the mean of its own part of the
+ *    texture (block means kept per texture, TEX_BLOCKS a side at most, sampled at points spread
+ *    over the triangle's texture coordinates), so a texture that glows in a few places (ToyCar's
+ *    lamps) makes lights there and nowhere else; triangles whose part is black are no lights;
  *  - at most SY_GL_MAX_AREA_LIGHTS polygons are lights: beyond that the most powerful are kept and
  *    their radiance is scaled so that the total emitted power (radiance x area x sides) is kept
  *    (a big emissive mesh lights like a few of its polygons, with its total power).
@@ -37,12 +40,14 @@
  * mediators/sy_mirror; this adapter turns its callbacks into OpenGL back-end calls. */
 /* >>tables: the records kept per back-end object or core id (maps of mediators/sy_mirror_map.h) */
 typedef struct emesh { /* per back-end mesh: the primitive's blobs (references) */
-    sy_blob *positions, *indices;
+    sy_blob *positions, *indices, *uv[2];
     uint32_t vertex_count, triangle_count;
 } emesh;
 typedef struct emat { /* per back-end material */
     float emission[3]; /* radiance: factor x strength (x the emissive texture's mean) */
     bool double_sided;
+    float factor[3];   /* factor x strength: what a textured emitter's triangles scale their block means by */
+    sy_mirror_flat_texture_ref tex; /* the emissive texture (id 0: none) */
 } emat;
 typedef struct einst { /* per back-end instance */
     uint32_t node; /* core node id (picks) */
@@ -54,9 +59,13 @@ typedef struct einst { /* per back-end instance */
 typedef struct ealb { /* per back-end material: diffuse-ish albedo (base x base texture mean) */
     float albedo[3];
 } ealb;
-typedef struct etex { /* per core texture id: mean linear RGB */
+typedef struct etex { /* per core texture id: mean linear RGB, block means (malloc'd) */
     float mean[3];
+    float *blocks; /* bw x bh x RGB (sy_mirror_flat_texture_blocks) */
+    uint32_t bw, bh, wrap_s, wrap_t;
 } etex;
+/* The block means' side at most: a 1024^2 emissive texture in blocks of 16^2 texels (48 KiB). */
+#define TEX_BLOCKS 64u
 
 typedef struct raster_state {
     sy_gl_device *dev;
@@ -141,12 +150,16 @@ static sy_result cb_material(void *user, const sy_mirror_material_args *a, sy_er
         al->albedo[i] = isfinite(v) ? fminf(fmaxf(v, 0.0f), 1.0f) : 0.0f;
     }
     /* emission as area light: factor x strength (x the emissive texture's mean) */
-    emat em = {{0, 0, 0}, d.double_sided};
+    emat em;
+    memset(&em, 0, sizeof em); /* compared whole (memcmp) */
+    em.double_sided = d.double_sided;
     const etex *et = m->emissive_texture.id ? sy_mirror_map_get(&st->texs, m->emissive_texture.id) : NULL;
     for (int i = 0; i < 3; ++i) {
         float v = d.emissive[i] * (m->emissive_texture.id ? (et ? et->mean[i] : 0.0f) : 1.0f);
         em.emission[i] = isfinite(v) && v > 0.0f ? v : 0.0f;
+        em.factor[i] = isfinite(d.emissive[i]) && d.emissive[i] > 0.0f ? d.emissive[i] : 0.0f;
     }
+    if (et && et->blocks) em.tex = m->emissive_texture;
     emat *old = sy_mirror_map_get(&st->mats, h.id);
     bool was = old && (old->emission[0] > 0 || old->emission[1] > 0 || old->emission[2] > 0);
     bool is = em.emission[0] > 0 || em.emission[1] > 0 || em.emission[2] > 0;
@@ -173,10 +186,18 @@ static sy_result cb_texture(void *user, const sy_mirror_texture_args *a, sy_erro
     sy_gl_result r = sy_gl_texture_create(st->dev, &d, &h);
     *a->handle = h.id;
     if (r != SY_GL_OK) return gl_fail(st, err, r, "texture");
-    /* mean linear RGB (for textured emitters as area lights) */
-    etex *t = sy_mirror_map_put(&st->texs, a->id);
-    if (!t) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (texture means)");
+    /* mean linear RGB and block means (for textured emitters as area lights) */
+    etex *t = sy_mirror_map_get(&st->texs, a->id);
+    if (t) free(t->blocks), t->blocks = NULL, st->areas_dirty = true; /* new pixels: a textured emitter's lights follow */
+    else if (!(t = sy_mirror_map_put(&st->texs, a->id)))
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (texture means)");
     sy_mirror_flat_texture_mean(f, t->mean);
+    t->bw = f->width < TEX_BLOCKS ? f->width : TEX_BLOCKS;
+    t->bh = f->height < TEX_BLOCKS ? f->height : TEX_BLOCKS;
+    t->wrap_s = f->wrap_s, t->wrap_t = f->wrap_t;
+    t->blocks = t->bw && t->bh ? malloc(sizeof(float) * 3 * t->bw * t->bh) : NULL;
+    if (!t->blocks && t->bw && t->bh) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (texture block means)");
+    if (t->blocks) sy_mirror_flat_texture_blocks(f, t->bw, t->bh, t->blocks);
     return SY_OK;
 }
 
@@ -195,6 +216,8 @@ static sy_result cb_primitive(void *user, const sy_mirror_primitive_args *a, sy_
     if (!em) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (mesh table)");
     em->positions = sy_blob_retain(p->positions);
     em->indices = sy_blob_retain(p->indices);
+    em->uv[0] = sy_blob_retain(p->texcoords0);
+    em->uv[1] = sy_blob_retain(p->texcoords1);
     em->vertex_count = d.vertex_count;
     em->triangle_count = d.triangle_count;
     return SY_OK;
@@ -214,9 +237,19 @@ static sy_result cb_primitive_update(void *user, const sy_mirror_primitive_args 
     if (em) {
         sy_blob_release(em->positions);
         em->positions = sy_blob_retain(a->primitive->positions);
+        sy_blob_release(em->uv[0]); /* a morph may move texture coordinates too */
+        em->uv[0] = sy_blob_retain(a->primitive->texcoords0);
     }
     st->areas_dirty = true; /* an emissive deformed mesh moves its area lights */
     return SY_OK;
+}
+
+static void emesh_release(emesh *em)
+{
+    sy_blob_release(em->positions);
+    sy_blob_release(em->indices);
+    sy_blob_release(em->uv[0]);
+    sy_blob_release(em->uv[1]);
 }
 
 static bool material_emits(const raster_state *st, uint32_t material) { return sy_mirror_map_get(&st->mats, material) != NULL; }
@@ -283,8 +316,7 @@ static void cb_release(void *user, const sy_mirror_release_args *a)
     case SY_MIRROR_PRIMITIVE: {
         emesh *em = sy_mirror_map_get(&st->meshes, a->handle);
         if (em) {
-            sy_blob_release(em->positions);
-            sy_blob_release(em->indices);
+            emesh_release(em);
             sy_mirror_map_del(&st->meshes, a->handle);
         }
         sy_gl_mesh_destroy(st->dev, (sy_gl_mesh){a->handle});
@@ -408,6 +440,12 @@ static void xform(const float *m, const float *p, float *o)
     for (int a = 0; a < 3; ++a) o[a] = m[a] * p[0] + m[4 + a] * p[1] + m[8 + a] * p[2] + m[12 + a];
 }
 static bool same3(const float *a, const float *b) { return a[0] == b[0] && a[1] == b[1] && a[2] == b[2]; }
+static float tri_area(const float t[3][3])
+{
+    float e1[3], e2[3], c[3];
+    sy_vec3_sub(t[1], t[0], e1), sy_vec3_sub(t[2], t[0], e2), sy_vec3_cross(e1, e2, c);
+    return 0.5f * sqrtf(sy_vec3_dot(c, c));
+}
 
 /* Tries to merge triangles A and B (world space, front = counter-clockwise) into a convex quad. */
 static bool merge_quad(const float a[3][3], const float b[3][3], float q[4][3])
@@ -441,7 +479,8 @@ static int cmp_power_desc(const void *a, const void *b)
     return x < y ? 1 : x > y ? -1 : 0;
 }
 
-static sy_result push_poly(poly **ps, size_t *n, size_t *cap, const float v[4][3], uint32_t nv, const emat *em, sy_error *err)
+static sy_result push_poly(poly **ps, size_t *n, size_t *cap, const float v[4][3], uint32_t nv, const float emission[3],
+                           bool double_sided, sy_error *err)
 {
     float e1[3], e2[3], c[3];
     sy_vec3_sub(v[1], v[0], e1), sy_vec3_sub(v[2], v[0], e2), sy_vec3_cross(e1, e2, c);
@@ -457,11 +496,63 @@ static sy_result push_poly(poly **ps, size_t *n, size_t *cap, const float v[4][3
     memset(p, 0, sizeof *p);
     memcpy(p->l.vertices, v, nv * sizeof v[0]);
     p->l.vertex_count = nv;
-    memcpy(p->l.radiance, em->emission, sizeof p->l.radiance);
-    p->l.double_sided = em->double_sided;
-    p->power = (0.2126f * em->emission[0] + 0.7152f * em->emission[1] + 0.0722f * em->emission[2]) * area *
-               (em->double_sided ? 2.0f : 1.0f);
+    memcpy(p->l.radiance, emission, sizeof p->l.radiance);
+    p->l.double_sided = double_sided;
+    p->power = (0.2126f * emission[0] + 0.7152f * emission[1] + 0.0722f * emission[2]) * area * (double_sided ? 2.0f : 1.0f);
     return SY_OK;
+}
+
+/* A texture coordinate wrapped as the sampler does (repeat 0, clamp 1, mirror 2) into [0, 1]. */
+static float wrap_coord(float x, uint32_t wrap)
+{
+    if (!isfinite(x)) return 0.0f;
+    if (wrap == 1u) return x < 0.0f ? 0.0f : x > 1.0f ? 1.0f : x;
+    float f = x - floorf(x);
+    if (wrap == 2u && ((int64_t)floorf(x) & 1)) f = 1.0f - f;
+    return f;
+}
+
+/* The radiance of triangle t of mesh me under emitting material em: the factor x the mean of the
+ * emissive texture's block means at points spread over the triangle's texture coordinates (k x k
+ * stratified points, k from the triangle's size in blocks, 2 .. 8); the material's emission where
+ * it has no texture or the mesh no such coordinates. */
+static void tri_emission(const raster_state *st, const emat *em, const emesh *me, const uint32_t vi[3], float out[3])
+{
+    const etex *tx = em->tex.id ? sy_mirror_map_get(&st->texs, em->tex.id) : NULL;
+    const sy_blob *uvb = me->uv[em->tex.texcoord < 2u ? em->tex.texcoord : 0u];
+    if (!tx || !tx->blocks || !uvb || sy_blob_size(uvb) < sizeof(float) * 2u * (size_t)me->vertex_count) {
+        memcpy(out, em->emission, 3 * sizeof(float));
+        return;
+    }
+    const float *uv = sy_blob_data(uvb);
+    float t[3][2];
+    for (int k = 0; k < 3; ++k) {
+        const float *q = uv + 2u * (size_t)vi[k];
+        const float *m = em->tex.transform;
+        t[k][0] = em->tex.transformed ? m[0] * q[0] + m[1] * q[1] + m[2] : q[0];
+        t[k][1] = em->tex.transformed ? m[3] * q[0] + m[4] * q[1] + m[5] : q[1];
+    }
+    /* the triangle's extent in blocks: as many points per side, 2 .. 8 */
+    float du = fmaxf(fabsf(t[1][0] - t[0][0]), fmaxf(fabsf(t[2][0] - t[0][0]), fabsf(t[2][0] - t[1][0]))) * (float)tx->bw;
+    float dv = fmaxf(fabsf(t[1][1] - t[0][1]), fmaxf(fabsf(t[2][1] - t[0][1]), fabsf(t[2][1] - t[1][1]))) * (float)tx->bh;
+    float ext = fmaxf(du, dv);
+    int kk = !(ext < 8.0f) ? 8 : ext < 2.0f ? 2 : (int)ceilf(ext);
+    double sum[3] = {0, 0, 0};
+    for (int a = 0; a < kk; ++a)
+        for (int b = 0; b < kk; ++b) { /* the unit square onto the triangle (square-root warp) */
+            float su = sqrtf((a + 0.5f) / (float)kk), v = (b + 0.5f) / (float)kk;
+            float w1 = su * (1.0f - v), w2 = su * v, w0 = 1.0f - w1 - w2;
+            float u = w0 * t[0][0] + w1 * t[1][0] + w2 * t[2][0], vv = w0 * t[0][1] + w1 * t[1][1] + w2 * t[2][1];
+            uint32_t bx = (uint32_t)(wrap_coord(u, tx->wrap_s) * (float)tx->bw), by = (uint32_t)(wrap_coord(vv, tx->wrap_t) * (float)tx->bh);
+            if (bx >= tx->bw) bx = tx->bw - 1u;
+            if (by >= tx->bh) by = tx->bh - 1u;
+            const float *c = tx->blocks + 3u * ((size_t)by * tx->bw + bx);
+            for (int ch = 0; ch < 3; ++ch) sum[ch] += c[ch];
+        }
+    for (int ch = 0; ch < 3; ++ch) {
+        float v = em->factor[ch] * (float)(sum[ch] / (double)(kk * kk));
+        out[ch] = isfinite(v) && v > 0.0f ? v : 0.0f;
+    }
 }
 
 static sy_result rebuild_area_lights(raster_state *st, sy_error *err)
@@ -479,33 +570,41 @@ static sy_result rebuild_area_lights(raster_state *st, sy_error *err)
         const uint32_t *idx = me->indices ? sy_blob_data(me->indices) : NULL;
         const float *m = in->world;
         float det = m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) + m[8] * (m[1] * m[6] - m[5] * m[2]);
-        float tri[2][3][3];
+        float tri[3][3], tri_e[3];
         bool pending = false;
         for (uint32_t t = 0; t < me->triangle_count && r == SY_OK; ++t) {
-            float w[3][3];
+            float w[3][3], e[3];
+            uint32_t vi[3];
             for (int k = 0; k < 3; ++k) {
-                uint32_t vi = idx ? idx[3 * t + k] : 3 * t + k;
-                if (vi >= me->vertex_count) vi = 0;
-                xform(m, pos + 3 * (size_t)vi, w[det < 0.0f ? 2 - k : k]); /* mirrored: keep the front face */
+                vi[k] = idx ? idx[3 * t + k] : 3 * t + k;
+                if (vi[k] >= me->vertex_count) vi[k] = 0;
+                xform(m, pos + 3 * (size_t)vi[k], w[det < 0.0f ? 2 - k : k]); /* mirrored: keep the front face */
             }
+            tri_emission(st, em, me, vi, e);
+            const bool emits = e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f;
             if (pending) {
                 float q[4][3];
-                if (merge_quad(tri[0], w, q)) {
-                    r = push_poly(&ps, &n, &cap, q, 4, em, err);
+                if (emits && merge_quad(tri, w, q)) { /* one light of the pair's area-weighted radiance */
+                    float a0 = tri_area(tri), a1 = tri_area(w), qe[3];
+                    for (int c = 0; c < 3; ++c) qe[c] = a0 + a1 > 0.0f ? (tri_e[c] * a0 + e[c] * a1) / (a0 + a1) : e[c];
+                    r = push_poly(&ps, &n, &cap, q, 4, qe, em->double_sided, err);
                     pending = false;
                     continue;
                 }
                 float v4[4][3];
-                memcpy(v4, tri[0], sizeof tri[0]);
-                r = push_poly(&ps, &n, &cap, v4, 3, em, err);
+                memcpy(v4, tri, sizeof tri);
+                r = push_poly(&ps, &n, &cap, v4, 3, tri_e, em->double_sided, err);
+                pending = false;
             }
-            memcpy(tri[0], w, sizeof w);
+            if (!emits) continue; /* its part of the texture is black */
+            memcpy(tri, w, sizeof w);
+            memcpy(tri_e, e, sizeof e);
             pending = true;
         }
         if (pending && r == SY_OK) {
             float v4[4][3];
-            memcpy(v4, tri[0], sizeof tri[0]);
-            r = push_poly(&ps, &n, &cap, v4, 3, em, err);
+            memcpy(v4, tri, sizeof tri);
+            r = push_poly(&ps, &n, &cap, v4, 3, tri_e, em->double_sided, err);
         }
     }
     /* the indirect light of the emitters as one uniform radiance (the "ambient term" of progressive
@@ -700,9 +799,11 @@ static void raster_destroy(void *state)
     sy_gl_device_destroy(st->dev);
     for (uint32_t i = 0; i < st->meshes.cap; ++i) {
         emesh *em = sy_mirror_map_slot(&st->meshes, i);
-        if (!em) continue;
-        sy_blob_release(em->positions);
-        sy_blob_release(em->indices);
+        if (em) emesh_release(em);
+    }
+    for (uint32_t i = 0; i < st->texs.cap; ++i) {
+        etex *t = sy_mirror_map_slot(&st->texs, i);
+        if (t) free(t->blocks);
     }
     sy_mirror_map_free(&st->meshes);
     sy_mirror_map_free(&st->mats);

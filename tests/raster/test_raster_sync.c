@@ -2,7 +2,9 @@
  * (a transform-only change uploads no vertex data, a material change is one uniform-buffer update,
  * a new mesh one upload of its buffers), exact emission of the Cornell light (17 12 4) in the float
  * layer, the Cornell walls and floor lit by that light within 20 % of the path tracer and still
- * lit after the light moves (a transform update keeps its area light), and parameter errors. */
+ * lit after the light moves (a transform update keeps its area light), parameter errors, and a
+ * textured emitter whose texture glows on one half: its area lights are that half (the floor under
+ * it as much brighter than under the dark half as the path tracer says). */
 #include "it_util.h"
 #include "sy_gltf.h"
 #include "sy_mediator_raster.h"
@@ -194,10 +196,99 @@ static void cornell(void)
     sy_scene_destroy(scene);
 }
 
+/* A panel facing down at height 1 over a white Lambert floor, its emission textured: black on its
+ * left half (x < 0), white on its right. Seen from between them, looking down at the floor: the
+ * ratio of the floor's luminance at x = +0.35 and x = -0.35 against the path tracer's (which
+ * evaluates the texture where its light samples land). The area lights took the texture's mean
+ * over the whole panel before (a ratio of 1.00 against the path tracer's 1.49). */
+static void textured_emitter(void)
+{
+    sy_scene *s;
+    MUST(sy_scene_create(&s, err));
+    enum { TW = 64 }; /* wide enough that the filtered step between the halves is a sliver */
+    unsigned char px[TW * 3];
+    for (int i = 0; i < TW * 3; ++i) px[i] = i < TW * 3 / 2 ? 0 : 255;
+    sy_texture tex;
+    MUST(sy_texture_create(s, "glow", &tex, err));
+    sy_image_info ii = {.width = TW, .height = 1, .channels = 3, .format = SY_PIXEL_U8_LINEAR};
+    sy_blob *pb = it_blob(px, sizeof px);
+    MUST(sy_texture_set_image(s, tex, &ii, pb, err));
+    sy_blob_release(pb);
+    sy_material lamp;
+    MUST(sy_material_create(s, "lamp", &lamp, err));
+    sy_material_data d = *sy_material_get(s, lamp);
+    d.name = "lamp";
+    d.base_color[0] = d.base_color[1] = d.base_color[2] = 0.0f;
+    d.emissive[0] = d.emissive[1] = d.emissive[2] = 1.0f;
+    d.emissive_strength = 4.0f;
+    d.emissive_texture.texture = tex;
+    MUST(sy_material_set(s, lamp, &d, err));
+    sy_material floor_m = it_lambert(s, "floor", 0.8f, 0.8f, 0.8f);
+    /* the panel: two quads facing -y (counter-clockwise seen from below), u 0 .. 0.5 on the left */
+    const float ppos[18] = {-1, 1, -0.5f, 0, 1, -0.5f, 1, 1, -0.5f, -1, 1, 0.5f, 0, 1, 0.5f, 1, 1, 0.5f};
+    const float puv[12] = {0, 0, 0.5f, 0, 1, 0, 0, 1, 0.5f, 1, 1, 1};
+    const uint32_t pidx[12] = {0, 1, 4, 0, 4, 3, 1, 2, 5, 1, 5, 4};
+    const float fpos[12] = {-2, 0, -2, -2, 0, 2, 2, 0, 2, 2, 0, -2}, fnrm[12] = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
+    const uint32_t fidx[6] = {0, 1, 2, 0, 2, 3};
+    sy_primitive pp = {0}, fp = {0};
+    pp.positions = it_blob(ppos, sizeof ppos), pp.texcoords0 = it_blob(puv, sizeof puv), pp.indices = it_blob(pidx, sizeof pidx);
+    pp.material = lamp;
+    fp.positions = it_blob(fpos, sizeof fpos), fp.normals = it_blob(fnrm, sizeof fnrm), fp.indices = it_blob(fidx, sizeof fidx);
+    fp.material = floor_m;
+    sy_mesh mp, mf;
+    MUST(sy_mesh_create(s, "panel", &mp, err));
+    MUST(sy_mesh_set_primitives(s, mp, &pp, 1, err));
+    MUST(sy_mesh_create(s, "floor", &mf, err));
+    MUST(sy_mesh_set_primitives(s, mf, &fp, 1, err));
+    sy_primitive_release(&pp), sy_primitive_release(&fp);
+    sy_node root, np, nf;
+    MUST(sy_node_create(s, "root", &root, err));
+    MUST(sy_node_create(s, "panel", &np, err));
+    MUST(sy_node_create(s, "floor", &nf, err));
+    MUST(sy_node_set_mesh(s, np, mp, err));
+    MUST(sy_node_set_mesh(s, nf, mf, err));
+    MUST(sy_node_add_child(s, root, np, err));
+    MUST(sy_node_add_child(s, root, nf, err));
+    MUST(sy_scene_commit(s, NULL, err));
+    /* from (0, 0.5, 0) looking down -y: camera x = world x, camera y = world -z */
+    sy_camera_view v = it_view_down_z(0.0f, 1.0f);
+    const float c2w[16] = {1, 0, 0, 0, 0, 0, -1, 0, 0, 1, 0, 0, 0, 0.5f, 0, 1};
+    memcpy(v.camera_to_world.m, c2w, sizeof c2w);
+    double ratio[2] = {0, 0};
+    static const char *const names[2] = {"raster", "pathtracer"};
+    for (int b = 0; b < 2; ++b) {
+        sy_params prm;
+        MUST(sy_params_parse(b == 0 ? "indirect=0" : "", &prm, err)); /* direct light: where it comes from */
+        sy_context *ctx;
+        MUST(sy_context_create(s, names[b], &prm, root.id, &ctx, err));
+        MUST(sy_context_sync(ctx, err));
+        sy_layer img;
+        MUST(it_render_full(ctx, &v, W, H, b ? 256 : 0, &img, err));
+        double side[2] = {0, 0}; /* x = -0.35 and +0.35: columns 0.325 W and 0.675 W, +- 3 pixels */
+        for (int k = 0; k < 2; ++k)
+            for (int y = H / 2 - 3; y < H / 2 + 3; ++y)
+                for (int x = (int)((k ? 0.675 : 0.325) * W) - 3; x < (int)((k ? 0.675 : 0.325) * W) + 3; ++x) {
+                    const float *q = it_px(&img, (uint32_t)x, (uint32_t)y);
+                    side[k] += 0.2126 * q[0] + 0.7152 * q[1] + 0.0722 * q[2];
+                }
+        ratio[b] = side[0] > 0.0 ? side[1] / side[0] : 0.0;
+        printf("textured emitter, %s: floor under the glowing half / under the dark half = %.3f (%.4f / %.4f)\n", names[b],
+               ratio[b], side[1] / 36.0, side[0] / 36.0);
+        sy_layer_destroy(&img);
+        sy_context_release(ctx);
+    }
+    EXPECT_MSG(ratio[1] > 1.3, "the path tracer's floor ratio %.3f: the scene does not test what it should", ratio[1]);
+    EXPECT_MSG(fabs(ratio[0] / ratio[1] - 1.0) < 0.15,
+               "a textured emitter lights as its texture says: the raster's floor ratio %.3f, the path tracer's %.3f", ratio[0],
+               ratio[1]);
+    sy_scene_destroy(s);
+}
+
 int main(void)
 {
     it_register();
     incremental();
     cornell();
+    textured_emitter();
     return sy_check_finish("raster_sync");
 }
