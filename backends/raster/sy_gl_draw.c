@@ -654,10 +654,10 @@ static sy_gl_result draw_instance(sy_gl_device *dev, draw_ctx *dc, uint32_t inde
      * of its own reads the environment through the probe's unit (sy_gli_draw_scene; issue 32: 8.7 ->
      * 5.3 s cold at 200x150 on llvmpipe, 1.7 -> 1.8 s warm). */
     pv = sy_gli_variant_normalize((pv | dc->shared) & ~(dev->shared_full ? VAR_LEAN : 0));
-    /* probe faces: one program for masked and other materials (those discard nothing: cutoff 0 in
-     * their block), so llvmpipe compiles one for the probes, not two (0.3-0.45 s each for
-     * TransmissionTest's; issue 32); a face of 16-256 texels loses little to the late depth test
-     * that discard brings */
+    /* probe faces: one program for masked and other materials (only a masked material's alpha
+     * discards: the main shader's SY_MASK test), so llvmpipe compiles one for the probes, not two
+     * (0.3-0.45 s each for TransmissionTest's; issue 32); a face of 16-256 texels loses little to
+     * the late depth test that discard brings */
     if (dev->in_probe_pass && dev->shared_masked) pv |= VAR_MASK;
     /* probe faces (16-256 px, seen blurred) shade without normal maps and material layers: a
      * smaller program that llvmpipe compiles in about half the time (docs/BACKENDS.md) */

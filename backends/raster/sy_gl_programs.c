@@ -109,9 +109,7 @@ void sy_gli_material_block(const sy_gl_device *dev, const sy_gl_material_desc *d
     b->mrna[0] = d->metallic;
     b->mrna[1] = d->roughness;
     b->mrna[2] = d->normal_scale;
-    /* the masked variants discard below it: 0 (never) for a material that is not masked, which a
-     * probe face draws with the masked program (sy_gl_draw.c draw_instance) */
-    b->mrna[3] = d->alpha_mode == SY_GL_ALPHA_MASK ? d->alpha_cutoff : 0.0f;
+    b->mrna[3] = d->alpha_cutoff; /* masked: coverage; blended: the shadow maps' threshold */
     b->oist[0] = d->occlusion_strength;
     b->oist[1] = d->ior >= 1.0f ? d->ior : 1.5f;
     b->oist[2] = d->specular;

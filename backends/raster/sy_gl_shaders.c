@@ -445,8 +445,11 @@ const char *const sy_gl_main_fs =
     "  if (m_tex.x >= 0) base *= texture(t_base, tuv(0, UVSET(m_tex.x)));\n"
     "#endif\n"
     "  float alpha = base.a;\n"
+    /* discard only in this variant: it disables early depth tests. The probe faces draw every
+     * material with it in a frame with a masked one (sy_gl_draw.c draw_instance): only a masked
+     * material's alpha is coverage */
     "#ifdef SY_MASK\n"
-    "  if (alpha < m_mrna.w) discard;\n" /* discard only in this variant: it disables early depth tests */
+    "  if (m_modes.x == 1 && alpha < m_mrna.w) discard;\n"
     "#endif\n"
     "  if (m_modes.x != 2) alpha = 1.0;\n"
     "  bool front = gl_FrontFacing != u_mirror;\n"

@@ -1,6 +1,6 @@
 /* test_gl_backend.c — the OpenGL rasterizer back-end alone, through its public API (sy_gl.h):
  * exact emission and linear depth, pixel-centre edges and sub-rectangles, Lambert + directional
- * shadow and spot falloff against analytic values, sorted premultiplied alpha blending, alpha
+ * shadow (an alpha-blended occluder's by its cutoff) and spot falloff against analytic values, sorted premultiplied alpha blending, alpha
  * mask, sRGB textures and downscaling with a warning, upload counters, shader-compile logs and the
  * "no display" error. argv[1] = provider (osmesa default; egl / glfw are skipped with the reason
  * when the machine cannot give such a context). */
@@ -291,6 +291,15 @@ int main(int argc, char **argv)
         EXPECT_MSG(px(42, 31)[0] < 0.05f * lit, "shadowed floor %g (lit %g)", px(42, 31)[0], lit);
         sy_gl_device_stats(d, &st);
         EXPECT_MSG(st.shadow_maps == 1, "shadow maps %u", st.shadow_maps);
+        /* an alpha-blended occluder blocks where its opacity reaches the cutoff (0.5), as the ray
+         * tracers' shadow rays threshold it: opacity 0.3 casts no shadow, 0.7 does (0.3 cast one
+         * while non-masked materials had cutoff 0 in their block) */
+        for (int k = 0; k < 2; ++k) {
+            MUST(sy_gl_instance_set_material(d, oc, material(d, 0.5f, 0.5f, 0.5f, k ? 0.7f : 0.3f, false, SY_GL_ALPHA_BLEND)));
+            render(d, &top);
+            EXPECT_MSG(k ? px(42, 31)[0] < 0.05f * lit : near_(px(42, 31)[0], lit, 0.01f),
+                       "floor under a blended occluder of opacity %g: %g (lit %g)", k ? 0.7 : 0.3, px(42, 31)[0], lit);
+        }
         MUST(sy_gl_light_destroy(d, l));
         MUST(sy_gl_instance_destroy(d, oc));
         /* spot at (0, 2, 0) pointing down: I / d^2 under it, zero beyond the outer cone */
