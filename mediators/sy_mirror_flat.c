@@ -54,7 +54,7 @@ void sy_mirror_flat_texture_mean(const sy_mirror_flat_texture *t, float mean[3])
 
 void sy_mirror_flat_texture_blocks(const sy_mirror_flat_texture *t, uint32_t gw, uint32_t gh, float *out)
 {
-    const size_t ch = t->channels, w = t->width, h = t->height;
+    const size_t ch = t->channels, w = t->width, h = t->height, step[3] = {0, ch <= 2 ? 0 : 1, ch <= 2 ? 0 : 2};
     float lut[256]; /* 8-bit codes decoded once */
     for (int v = 0; v < 256; ++v) lut[v] = t->format == SY_MIRROR_FLAT_UNORM8_SRGB ? sy_srgb_decode(v / 255.0f) : v / 255.0f;
     for (uint32_t j = 0; j < gh; ++j) {
@@ -62,18 +62,23 @@ void sy_mirror_flat_texture_blocks(const sy_mirror_flat_texture *t, uint32_t gw,
         for (uint32_t i = 0; i < gw; ++i) {
             const size_t x0 = i * w / gw, x1 = (i + 1u) * w / gw;
             double sum[3] = {0, 0, 0};
-            size_t n = 0;
-            for (size_t y = y0; y < y1; ++y)
-                for (size_t x = x0; x < x1; ++x, ++n) {
-                    const size_t o = (y * w + x) * ch;
-                    for (size_t c = 0; c < 3; ++c) {
-                        const size_t k = o + (ch <= 2 ? 0 : c);
-                        float v = t->format == SY_MIRROR_FLAT_FLOAT32 ? ((const float *)t->pixels)[k]
-                                                                      : lut[((const unsigned char *)t->pixels)[k]];
-                        if (isfinite(v)) sum[c] += v;
-                    }
+            for (size_t y = y0; y < y1; ++y) {
+                const size_t row = (y * w + x0) * ch, n = (x1 - x0) * ch;
+                if (t->format == SY_MIRROR_FLAT_FLOAT32) {
+                    const float *px = (const float *)t->pixels + row;
+                    for (size_t k = 0; k < n; k += ch)
+                        for (int c = 0; c < 3; ++c)
+                            if (isfinite(px[k + step[c]])) sum[c] += px[k + step[c]];
+                } else { /* a block row's sum in float (width / gw + 1 texels of at most 1 each) */
+                    const unsigned char *px = (const unsigned char *)t->pixels + row;
+                    float rs[3] = {0, 0, 0};
+                    for (size_t k = 0; k < n; k += ch)
+                        for (int c = 0; c < 3; ++c) rs[c] += lut[px[k + step[c]]];
+                    for (int c = 0; c < 3; ++c) sum[c] += rs[c];
                 }
-            for (int c = 0; c < 3; ++c) out[3 * ((size_t)j * gw + i) + (size_t)c] = n ? (float)(sum[c] / (double)n) : 0.0f;
+            }
+            const double count = (double)((x1 - x0) * (y1 - y0));
+            for (int c = 0; c < 3; ++c) out[3 * ((size_t)j * gw + i) + (size_t)c] = count > 0.0 ? (float)(sum[c] / count) : 0.0f;
         }
     }
 }
