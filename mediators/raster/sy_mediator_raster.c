@@ -507,8 +507,9 @@ static float wrap_coord(float x, uint32_t wrap)
 {
     if (!isfinite(x)) return 0.0f;
     if (wrap == 1u) return x < 0.0f ? 0.0f : x > 1.0f ? 1.0f : x;
-    float f = x - floorf(x);
-    if (wrap == 2u && ((int64_t)floorf(x) & 1)) f = 1.0f - f;
+    const float fl = floorf(x);
+    float f = x - fl;
+    if (wrap == 2u && fabsf(fmodf(fl, 2.0f)) == 1.0f) f = 1.0f - f; /* odd periods mirror (no integer cast: any finite x) */
     return f;
 }
 
