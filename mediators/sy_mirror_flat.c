@@ -25,62 +25,53 @@ void sy_mirror_flat_texture_of(const sy_image_info *info, const sy_sampler *samp
     };
 }
 
-void sy_mirror_flat_texture_mean(const sy_mirror_flat_texture *t, float mean[3])
+bool sy_mirror_flat_texture_means(const sy_mirror_flat_texture *t, uint32_t gw, uint32_t gh, float mean[3], float *blocks)
 {
-    size_t n = (size_t)t->width * t->height, ch = t->channels;
-    double sum[3] = {0, 0, 0};
-    if (t->format == SY_MIRROR_FLAT_FLOAT32) {
-        const float *px = t->pixels;
-        for (size_t i = 0; i < n; ++i)
-            for (size_t c = 0; c < 3; ++c) {
-                float v = px[i * ch + (ch <= 2 ? 0 : c)];
-                if (isfinite(v)) sum[c] += v;
-            }
-    } else { /* 8 bits: count each code, then decode 256 values instead of one per texel */
-        static const size_t zero[256];
-        size_t count[3][256];
-        for (size_t c = 0; c < 3; ++c) memcpy(count[c], zero, sizeof zero);
-        const unsigned char *px = t->pixels;
-        for (size_t i = 0; i < n; ++i)
-            for (size_t c = 0; c < 3; ++c) count[c][px[i * ch + (ch <= 2 ? 0 : c)]]++;
-        for (int v = 0; v < 256; ++v) {
-            float x = v / 255.0f;
-            if (t->format == SY_MIRROR_FLAT_UNORM8_SRGB) x = sy_srgb_decode(x);
-            for (size_t c = 0; c < 3; ++c) sum[c] += (double)count[c][v] * x;
-        }
-    }
-    for (int c = 0; c < 3; ++c) mean[c] = n ? (float)(sum[c] / (double)n) : 0.0f;
-}
-
-void sy_mirror_flat_texture_blocks(const sy_mirror_flat_texture *t, uint32_t gw, uint32_t gh, float *out)
-{
-    const size_t ch = t->channels, w = t->width, h = t->height, step[3] = {0, ch <= 2 ? 0 : 1, ch <= 2 ? 0 : 2};
+    const size_t ch = t->channels, w = t->width, h = t->height, n = w * h, step[3] = {0, ch <= 2 ? 0 : 1, ch <= 2 ? 0 : 2};
+    const bool is_float = t->format == SY_MIRROR_FLAT_FLOAT32;
     float lut[256]; /* 8-bit codes decoded once */
     for (int v = 0; v < 256; ++v) lut[v] = t->format == SY_MIRROR_FLAT_UNORM8_SRGB ? sy_srgb_decode(v / 255.0f) : v / 255.0f;
+    /* the whole image's sum: float texels added in row order; 8-bit codes counted, then 256
+     * values decoded instead of one per texel */
+    double sum[3] = {0, 0, 0};
+    static const size_t zero[256];
+    size_t count[3][256];
+    for (size_t c = 0; c < 3; ++c) memcpy(count[c], zero, sizeof zero);
+    double *row_sums = calloc((size_t)gw * 3 + 3, sizeof *row_sums); /* the blocks of one block row */
+    if (!row_sums) return false;
     for (uint32_t j = 0; j < gh; ++j) {
         const size_t y0 = j * h / gh, y1 = (j + 1u) * h / gh;
-        for (uint32_t i = 0; i < gw; ++i) {
-            const size_t x0 = i * w / gw, x1 = (i + 1u) * w / gw;
-            double sum[3] = {0, 0, 0};
-            for (size_t y = y0; y < y1; ++y) {
-                const size_t row = (y * w + x0) * ch, n = (x1 - x0) * ch;
-                if (t->format == SY_MIRROR_FLAT_FLOAT32) {
+        memset(row_sums, 0, sizeof *row_sums * 3 * gw);
+        for (size_t y = y0; y < y1; ++y) /* each image row once, left to right: row order */
+            for (uint32_t i = 0; i < gw; ++i) {
+                const size_t x0 = i * w / gw, x1 = (i + 1u) * w / gw, row = (y * w + x0) * ch, m = (x1 - x0) * ch;
+                float bs[3] = {0, 0, 0}; /* a block row's part in float (width / gw + 1 texels of at most 1 each) */
+                if (is_float) {
                     const float *px = (const float *)t->pixels + row;
-                    for (size_t k = 0; k < n; k += ch)
-                        for (int c = 0; c < 3; ++c)
-                            if (isfinite(px[k + step[c]])) sum[c] += px[k + step[c]];
-                } else { /* a block row's sum in float (width / gw + 1 texels of at most 1 each) */
+                    for (size_t k = 0; k < m; k += ch)
+                        for (int c = 0; c < 3; ++c) {
+                            const float v = px[k + step[c]];
+                            if (isfinite(v)) sum[c] += v, bs[c] += v;
+                        }
+                } else {
                     const unsigned char *px = (const unsigned char *)t->pixels + row;
-                    float rs[3] = {0, 0, 0};
-                    for (size_t k = 0; k < n; k += ch)
-                        for (int c = 0; c < 3; ++c) rs[c] += lut[px[k + step[c]]];
-                    for (int c = 0; c < 3; ++c) sum[c] += rs[c];
+                    for (size_t k = 0; k < m; k += ch)
+                        for (int c = 0; c < 3; ++c) count[c][px[k + step[c]]]++, bs[c] += lut[px[k + step[c]]];
                 }
+                for (int c = 0; c < 3; ++c) row_sums[3u * i + (size_t)c] += bs[c];
             }
-            const double count = (double)((x1 - x0) * (y1 - y0));
-            for (int c = 0; c < 3; ++c) out[3 * ((size_t)j * gw + i) + (size_t)c] = count > 0.0 ? (float)(sum[c] / count) : 0.0f;
+        for (uint32_t i = 0; i < gw; ++i) {
+            const double texels = (double)(((i + 1u) * w / gw - i * w / gw) * (y1 - y0));
+            for (int c = 0; c < 3; ++c)
+                blocks[3 * ((size_t)j * gw + i) + (size_t)c] = texels > 0.0 ? (float)(row_sums[3u * i + (size_t)c] / texels) : 0.0f;
         }
     }
+    free(row_sums);
+    if (!is_float)
+        for (int v = 0; v < 256; ++v)
+            for (size_t c = 0; c < 3; ++c) sum[c] += (double)count[c][v] * lut[v];
+    for (int c = 0; c < 3; ++c) mean[c] = n ? (float)(sum[c] / (double)n) : 0.0f;
+    return true;
 }
 
 /* A factor the specifications bound to [0, 1] (core accepts any non-negative value). */

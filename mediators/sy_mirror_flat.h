@@ -221,15 +221,13 @@ typedef struct sy_mirror_flat_light {
 void sy_mirror_flat_texture_of(const sy_image_info *info, const sy_sampler *sampler, const void *pixels,
                                sy_mirror_flat_texture *out);
 
-/** Mean linear RGB of a texture (sRGB decoded; grey read as R = G = B; non-finite texels skipped;
- * 0 for an empty one). */
-void sy_mirror_flat_texture_mean(const sy_mirror_flat_texture *t, float mean[3]);
-
-/** Block means of a texture: out[3 (j gw + i) ..] = the mean linear RGB of block (i, j) of a gw x
- * gh partition (block i spans texel columns [i w / gw, (i + 1) w / gw), rows likewise, row 0 at the
- * top), decoded as sy_mirror_flat_texture_mean; 1 <= gw <= width, 1 <= gh <= height. The raster
- * mediator's textured emitters light with their triangles' own part of the texture. */
-void sy_mirror_flat_texture_blocks(const sy_mirror_flat_texture *t, uint32_t gw, uint32_t gh, float *out);
+/** The mean linear RGB of a texture (sRGB decoded; grey read as R = G = B; non-finite texels
+ * skipped; 0 for an empty one) into mean, and of each block of a gw x gh partition into blocks
+ * (blocks[3 (j gw + i) ..] for block (i, j): texel columns [i w / gw, (i + 1) w / gw), rows likewise,
+ * row 0 at the top), in one pass over the pixels; 1 <= gw <= width, 1 <= gh <= height unless the
+ * texture is empty. The raster mediator's albedo estimate takes the mean, its textured emitters
+ * light with their triangles' own blocks. False without memory. */
+bool sy_mirror_flat_texture_means(const sy_mirror_flat_texture *t, uint32_t gw, uint32_t gh, float mean[3], float *blocks);
 
 /** Back-end handle of a core texture id (0 = none), as the caller's mirror knows it. */
 typedef uint32_t (*sy_mirror_flat_handle_fn)(const void *user, uint32_t texture_id);

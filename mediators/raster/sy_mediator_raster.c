@@ -61,7 +61,7 @@ typedef struct ealb { /* per back-end material: diffuse-ish albedo (base x base 
 } ealb;
 typedef struct etex { /* per core texture id: mean linear RGB, block means (malloc'd) */
     float mean[3];
-    float *blocks; /* bw x bh x RGB (sy_mirror_flat_texture_blocks) */
+    float *blocks; /* bw x bh x RGB (sy_mirror_flat_texture_means); NULL for an empty texture */
     uint32_t bw, bh, wrap_s, wrap_t;
 } etex;
 /* The block means' side at most: a 1024^2 emissive texture in blocks of 16^2 texels (48 KiB). */
@@ -191,13 +191,12 @@ static sy_result cb_texture(void *user, const sy_mirror_texture_args *a, sy_erro
     if (t) free(t->blocks), t->blocks = NULL, st->areas_dirty = true; /* new pixels: a textured emitter's lights follow */
     else if (!(t = sy_mirror_map_put(&st->texs, a->id)))
         return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (texture means)");
-    sy_mirror_flat_texture_mean(f, t->mean);
     t->bw = f->width < TEX_BLOCKS ? f->width : TEX_BLOCKS;
     t->bh = f->height < TEX_BLOCKS ? f->height : TEX_BLOCKS;
     t->wrap_s = f->wrap_s, t->wrap_t = f->wrap_t;
-    t->blocks = t->bw && t->bh ? malloc(sizeof(float) * 3 * t->bw * t->bh) : NULL;
-    if (!t->blocks && t->bw && t->bh) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (texture block means)");
-    if (t->blocks) sy_mirror_flat_texture_blocks(f, t->bw, t->bh, t->blocks);
+    t->blocks = t->bw && t->bh ? malloc(sizeof(float) * 3 * t->bw * t->bh) : NULL; /* none for an empty texture */
+    if ((t->bw && t->bh && !t->blocks) || !sy_mirror_flat_texture_means(f, t->bw, t->bh, t->mean, t->blocks))
+        return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "raster: out of memory (texture means)");
     return SY_OK;
 }
 
@@ -513,22 +512,39 @@ static float wrap_coord(float x, uint32_t wrap)
     return f;
 }
 
-/* The radiance of triangle t of mesh me under emitting material em: the factor x the mean of the
- * emissive texture's block means at points spread over the triangle's texture coordinates (k x k
- * stratified points, k from the triangle's size in blocks, 2 .. 8); the material's emission where
- * it has no texture or the mesh no such coordinates. */
-static void tri_emission(const raster_state *st, const emat *em, const emesh *me, const uint32_t vi[3], float out[3])
+/* What the triangles of one emissive instance light with: its material, and where the material's
+ * emission is textured, the texture's block means and the mesh's coordinates of the texture's set
+ * (tx NULL: the material's emission for every triangle). */
+typedef struct emit_src {
+    const emat *em;
+    const etex *tx;
+    const float *uv;
+} emit_src;
+
+static emit_src emit_src_of(const raster_state *st, const emat *em, const emesh *me)
 {
+    emit_src e = {em, NULL, NULL};
     const etex *tx = em->tex.id ? sy_mirror_map_get(&st->texs, em->tex.id) : NULL;
     const sy_blob *uvb = me->uv[em->tex.texcoord < 2u ? em->tex.texcoord : 0u];
-    if (!tx || !tx->blocks || !uvb || sy_blob_size(uvb) < sizeof(float) * 2u * (size_t)me->vertex_count) {
+    if (tx && tx->blocks && uvb && sy_blob_size(uvb) >= sizeof(float) * 2u * (size_t)me->vertex_count)
+        e.tx = tx, e.uv = sy_blob_data(uvb);
+    return e;
+}
+
+/* The radiance of the triangle of vertices vi: the factor x the mean of the emissive texture's
+ * block means at points spread over the triangle's texture coordinates (k x k stratified points,
+ * k from the triangle's size in blocks, 2 .. 8); the material's emission without a texture. */
+static void tri_emission(const emit_src *src, const uint32_t vi[3], float out[3])
+{
+    const emat *em = src->em;
+    const etex *tx = src->tx;
+    if (!tx) {
         memcpy(out, em->emission, 3 * sizeof(float));
         return;
     }
-    const float *uv = sy_blob_data(uvb);
     float t[3][2];
     for (int k = 0; k < 3; ++k) {
-        const float *q = uv + 2u * (size_t)vi[k];
+        const float *q = src->uv + 2u * (size_t)vi[k];
         const float *m = em->tex.transform;
         t[k][0] = em->tex.transformed ? m[0] * q[0] + m[1] * q[1] + m[2] : q[0];
         t[k][1] = em->tex.transformed ? m[3] * q[0] + m[4] * q[1] + m[5] : q[1];
@@ -573,6 +589,7 @@ static sy_result rebuild_area_lights(raster_state *st, sy_error *err)
         float det = m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) + m[8] * (m[1] * m[6] - m[5] * m[2]);
         float tri[3][3], tri_e[3];
         bool pending = false;
+        const emit_src src = emit_src_of(st, em, me);
         for (uint32_t t = 0; t < me->triangle_count && r == SY_OK; ++t) {
             float w[3][3], e[3];
             uint32_t vi[3];
@@ -581,7 +598,7 @@ static sy_result rebuild_area_lights(raster_state *st, sy_error *err)
                 if (vi[k] >= me->vertex_count) vi[k] = 0;
                 xform(m, pos + 3 * (size_t)vi[k], w[det < 0.0f ? 2 - k : k]); /* mirrored: keep the front face */
             }
-            tri_emission(st, em, me, vi, e);
+            tri_emission(&src, vi, e);
             const bool emits = e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f;
             if (pending) {
                 float q[4][3];
