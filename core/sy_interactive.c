@@ -156,12 +156,12 @@ sy_result sy_interactive_backend_index(const char *name, uint32_t *index, sy_err
     return sy_error_set(err, SY_ERR_NOT_FOUND, "back-end '%s' is not registered (see sy backends)", name);
 }
 
-sy_result sy_interactive_create(double budget_ms, sy_interactive **out, sy_error *err)
+sy_result sy_interactive_create(const sy_governor_desc *gov, sy_interactive **out, sy_error *err)
 {
     *out = NULL;
     sy_interactive *ia = calloc(1, sizeof *ia);
     if (!ia) return sy_error_set(err, SY_ERR_OUT_OF_MEMORY, "interactive view: out of memory");
-    sy_result r = sy_governor_create(&(sy_governor_desc){.budget_ms = budget_ms}, &ia->gov, err);
+    sy_result r = sy_governor_create(gov, &ia->gov, err);
     if (r != SY_OK) {
         free(ia);
         return r;

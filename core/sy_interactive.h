@@ -84,8 +84,8 @@ sy_result sy_interactive_set_fov(sy_scene *scene, sy_node camera, float fov, sy_
 /** The render thread's state (opaque). */
 typedef struct sy_interactive sy_interactive;
 
-/** Creates it with a governor of budget_ms (0: 33; sy_governor_desc). */
-sy_result sy_interactive_create(double budget_ms, sy_interactive **out, sy_error *err);
+/** Creates it with a governor of those settings (NULL: the defaults; sy_governor_desc). */
+sy_result sy_interactive_create(const sy_governor_desc *gov, sy_interactive **out, sy_error *err);
 void sy_interactive_destroy(sy_interactive *ia); /**< NULL-safe */
 
 /** What a frame shows, for sy_interactive_plan. */

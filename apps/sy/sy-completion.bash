@@ -32,7 +32,7 @@ _sy_options() {
                   $_sy_cluster $_sy_common" ;;
     view) echo "-b -w -h --camera --look-at --orbit --fov --bookmark --bookmarks --clip --clip-cap --hide --isolate --select --overlay --composite --frames --screenshot --filter --threshold --keys --spp --budget --no-temporal
                 $_sy_cluster $_sy_common" ;;
-    web) echo "-b -w -h --camera --look-at --orbit --fov --bookmark --hide --isolate --select --listen --quality --filter --threshold --budget --client-render --no-temporal --read-only --clip --bookmarks --delay-ms $_sy_common" ;;
+    web) echo "-b -w -h --camera --look-at --orbit --fov --bookmark --hide --isolate --select --listen --quality --filter --threshold --budget --min-scale --client-render --no-temporal --read-only --clip --bookmarks --delay-ms $_sy_common" ;;
     info) echo "--json $_sy_common" ;;
     compare) echo "-w -h -o --spp --camera --backends $_sy_common" ;;
     convert) echo "-o $_sy_common" ;;

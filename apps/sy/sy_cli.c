@@ -248,7 +248,7 @@ static const char usage_text[] =
             "  sy web SCENE [-b BACKEND] [--listen HOST:PORT] [--camera C] [-w MAX_W] [-h MAX_H] [--quality Q]\n"
             "          [--look-at EYE:TARGET[:UP] | --orbit AZ,EL[,DIST]] [--fov DEG]   (the start view; as sy render)\n"
             "          [--hide NODE] [--isolate NODE] [--select NODE]   (the start state; as sy render)\n"
-            "          [--filter none|pixel|...] [--threshold T] [--budget MS] [--client-render]   (the view in a browser:\n"
+            "          [--filter none|pixel|...] [--threshold T] [--budget MS] [--min-scale S] [--client-render]   (the view in a browser:\n"
             "           open the URL it prints; another address than loopback needs the printed token)\n"
             "          [--read-only]   (viewers move the camera, pick and take stills, but change no visibility,\n"
             "           selection, section plane, exposure, filter or back-end)\n"

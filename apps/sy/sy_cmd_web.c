@@ -20,7 +20,7 @@
 
 #ifdef SY_HAVE_WEB
 /* `sy web SCENE`: the view in a web browser (apps/web/sy_web.h, docs/WEB.md). */
-enum { OPT_WEB_LISTEN = 0x300, OPT_WEB_QUALITY, OPT_WEB_CLIENT_RENDER, OPT_WEB_DELAY, OPT_WEB_READ_ONLY };
+enum { OPT_WEB_LISTEN = 0x300, OPT_WEB_QUALITY, OPT_WEB_CLIENT_RENDER, OPT_WEB_DELAY, OPT_WEB_READ_ONLY, OPT_WEB_MIN_SCALE };
 int sy_cmd_web(int argc, char **argv)
 {
     const char *backend = NULL, *camera = NULL, *listen = NULL, *filter = NULL, *scene = NULL;
@@ -29,12 +29,14 @@ int sy_cmd_web(int argc, char **argv)
     uint32_t w = 1920, h = 1200, quality = 80, delay_ms = 0;
     float threshold = 0.0f;
     double budget = 0; /* 0: the governor's default (33 ms) */
+    float min_scale = 0.0f; /* 0: SY_WEB_MIN_SCALE */
     bool client_render = false, no_temporal = false, read_only = false;
     const sy_cli_opt opts[] = {
         SY_CLI_OPT_TEXT(NULL, 'b', &backend), SY_CLI_OPT_TEXT("camera", OPT_CAMERA, &camera),
         SY_CLI_OPT_TEXT("listen", OPT_WEB_LISTEN, &listen), SY_CLI_OPT_UINT("quality", OPT_WEB_QUALITY, &quality, 1, 100),
         SY_CLI_OPT_TEXT("filter", OPT_FILTER, &filter), SY_CLI_OPT_FLOAT("threshold", OPT_THRESHOLD, &threshold, 0, FLT_MAX),
         SY_CLI_OPT_REAL("budget", OPT_BUDGET, &budget, 1.0, 10000.0), /* the frame-time governor's budget (ms) */
+        SY_CLI_OPT_FLOAT("min-scale", OPT_WEB_MIN_SCALE, &min_scale, 0.03125f, 1.0f), /* moving frames' smallest scale */
         SY_CLI_OPT_FLAG("client-render", OPT_WEB_CLIENT_RENDER, &client_render),
         SY_CLI_OPT_FLAG("no-temporal", OPT_NO_TEMPORAL, &no_temporal),
         SY_CLI_OPT_FLAG("read-only", OPT_WEB_READ_ONLY, &read_only), /* viewers look, they do not change the scene */
@@ -50,7 +52,7 @@ int sy_cmd_web(int argc, char **argv)
     if (sy_cli_load(scene, camera, true, &ld, &err) != SY_OK) return sy_cli_fail(&err);
     sy_web_desc d = {.scene = ld.scene, .root = ld.root, .camera = ld.camera, .background = ld.background,
                      .backend = backend, .listen = listen, .max_width = w, .max_height = h, .quality = (int)quality,
-                     .filter = filter, .threshold = threshold, .budget_ms = budget, .delay_ms = delay_ms,
+                     .filter = filter, .threshold = threshold, .budget_ms = budget, .min_scale = min_scale, .delay_ms = delay_ms,
                      .no_temporal = no_temporal, .read_only = read_only, .clip = sy_cli_default_clip(&ld)};
     char *marks = NULL; /* the saved views beside the scene file (not for the built-in demo) */
     d.bookmarks = sy_cli_bookmarks_file(scene, bookmarks, &marks);

@@ -369,7 +369,7 @@ static void *render_main(void *p)
     double wait_until = 0;  /* ms (sy_time_now): the governor's settle wait, 0 = none */
     char fstatus[96] = "";
     sy_interactive *ia = NULL; /* the governor, the display filter (sy_interactive.h) */
-    if (sy_interactive_create(a->budget_ms, &ia, &err) != SY_OK) goto fail_unlocked;
+    if (sy_interactive_create(&(sy_governor_desc){.budget_ms = a->budget_ms}, &ia, &err) != SY_OK) goto fail_unlocked;
     sy_interactive_set_temporal(ia, !a->no_temporal);
     /* what the last planned frame showed besides the view, back-end and size: a difference is a
      * view change for the governor */

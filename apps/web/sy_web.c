@@ -134,6 +134,7 @@ sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err)
     if (!w->d.still_deadline_ms) w->d.still_deadline_ms = 10000;
     if (!w->d.head_timeout_ms) w->d.head_timeout_ms = 5000;
     if (!w->d.max_pending) w->d.max_pending = 128;
+    if (!w->d.min_scale) w->d.min_scale = SY_WEB_MIN_SCALE;
     w->initial_backend = w->backend = bi;
     pthread_mutex_init(&w->mu, NULL);
     /* the timeline: the range of desc->clip (every clip together: {0}), paused at its start (a page

@@ -47,6 +47,13 @@
 extern "C" {
 #endif
 
+/** The default smallest resolution of a moving frame (sy_web_desc.min_scale, sy web --min-scale):
+ * the governor's (an eighth of the display's side). A page that warps answers every input itself,
+ * so a larger floor trades the server's frame rate for the detail the warp works from (docs/WEB.md,
+ * "The estimate during an orbit": DamagedHelmet's estimate SSIM 0.80 with 60 x 45 moving frames,
+ * 0.88-0.89 with --min-scale 0.5, at the same 3.5 frames a second on the 2-core machine) */
+#define SY_WEB_MIN_SCALE 0.125f
+
 /** A request given to a route handler (valid during the call). */
 typedef struct sy_web_request {
     const char *method;   /**< "GET" or "POST" */
@@ -98,6 +105,8 @@ typedef struct sy_web_desc {
     int quality;              /**< quality of streamed frames, 1..100 (default 80; stills: JPEG 95): JPEG's, and
                                *   the video stream's quantizer through sy_web_video_quantizer (80: 36) */
     double budget_ms;         /**< frame-time budget of the governor while the view moves (default 33) */
+    float min_scale;          /**< smallest resolution of a moving frame, a share of the display's side (0, 1];
+                               *   0: SY_WEB_MIN_SCALE */
     uint32_t still_samples;   /**< samples per pixel of a progressive back-end's still (default 16) */
     uint32_t idle_timeout_s;  /**< a silent WebSocket is pinged, then closed after twice this (default 30) */
     const char *filter;       /**< initial display filter of a back-end with SY_CAP_FILTERS (NULL: none) */

@@ -491,7 +491,8 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
     if (r == SY_OK) r = sy_window_add_viewport(rs.win, &vd, &rs.vp, err);
     if (r == SY_OK) r = sy_window_create(64, 64, &rs.still_win, err);
     if (r == SY_OK) r = sy_window_add_viewport(rs.still_win, &vd, &rs.still_vp, err);
-    if (r == SY_OK) r = sy_interactive_create(w->d.budget_ms, &rs.ia, err);
+    if (r == SY_OK)
+        r = sy_interactive_create(&(sy_governor_desc){.budget_ms = w->d.budget_ms, .min_scale = w->d.min_scale}, &rs.ia, err);
     if (r == SY_OK) sy_interactive_set_temporal(rs.ia, !w->d.no_temporal);
     rs.backend_applied = w->initial_backend;
     if (r == SY_OK) warm_up(w, &rs);

@@ -18,6 +18,21 @@
 //     channel wrongly, one four times the size asked for): their counts in sy.stats().bad and
 //     whether the canvas stayed the same. URL?warp=0 gives the same drag without the warp and
 //     without the rest (the comparison).
+//   node browser.mjs orbit URL OUTDIR WIDTH HEIGHT
+//     The estimate during an orbit (a measurement; docs/WEB.md, "The estimate during an orbit"):
+//     once a full-size frame answers every input, the page itself drags the orbit at
+//     SY_ORBIT_DEG_S degrees a second (default 10) for SY_ORBIT_S seconds (default 6), one input
+//     per display frame (sy.input, its dx from the time since the last), and captures the display
+//     frame every SY_ORBIT_EVERY_MS (default 250; sy.capture: the pixels before the browser shows
+//     them, whether they are an estimate, the view, the share the hole fill left empty).
+//     SY_ORBIT_HOLD=1: the references held from the start (sy.hold), so that every capture is
+//     the first frame warped by the angle turned since, whatever the server and the load do.
+//     Then, for each capture that was an estimate, the server's exact frame of the same view (a
+//     drag back to it, waited for until a full-size frame answers it, captured): OUTDIR/est_K.png
+//     and OUTDIR/true_K.png, K from 0, compared by SY_PNG_SSIM (tests/support/png_ssim.c: SSIM of
+//     luma). Prints {captures: [{k, ms, estimate, unfilled, yaw, yaw_true, refs, turned_deg, ssim}],
+//     ssim_median, ssim_p10, ssim_min over the estimates, unfilled_max over all captures,
+//     yaw_diff_max (estimate's view against its true frame's), ...}.
 //   node browser.mjs tools URL OUTDIR WIDTH HEIGHT
 //     The page's tools (sy web, a canvas wide enough for the panel): finds a covered pixel near
 //     the centre (the server's still of the view), clicks it (pick + select; the properties show
@@ -73,12 +88,13 @@
 // included), 77 when chromium cannot be started.
 import { chromium } from 'playwright-core';
 import { readFileSync, writeFileSync } from 'node:fs';
+import { execFileSync } from 'node:child_process';
 import { join } from 'node:path';
 
 const [mode, url, outDir, wArg, hArg] = process.argv.slice(2);
 const width = Number(wArg || 480), height = Number(hArg || 360);
-if (!['stream', 'client', 'client_timeline', 'warp', 'tools', 'video', 'timeline', 'first', 'converge', 'tree'].includes(mode) || !url || !outDir) {
-  console.error('usage: node browser.mjs stream|client|client_timeline|warp|tools|video|timeline|first|converge|tree URL OUTDIR [WIDTH HEIGHT]');
+if (!['stream', 'client', 'client_timeline', 'warp', 'orbit', 'tools', 'video', 'timeline', 'first', 'converge', 'tree'].includes(mode) || !url || !outDir) {
+  console.error('usage: node browser.mjs stream|client|client_timeline|warp|orbit|tools|video|timeline|first|converge|tree URL OUTDIR [WIDTH HEIGHT]');
   process.exit(2);
 }
 const executablePath = process.env.SY_CHROMIUM || '/usr/bin/chromium';
@@ -360,6 +376,80 @@ try {
                                  server_fps: st.server_fps, bytes_per_frame: Math.round(st.bytes_per_frame),
                                  frames_during_drag: st.frames - frames0, mid, quality, bad: st.bad, badFrames, consoleErrors,
                                  input_to_display_all: drag.map((v) => Math.round(v)) }));
+  } else if (mode === 'orbit') {
+    const settled = () => page.waitForFunction(
+      ([w, h]) => window.syStats && window.sy && syStats.frames > 0 && syStats.width === w && syStats.height === h &&
+                  syStats.answeredInput === syStats.lastInput && sy.stats().estimate_share === 0,
+      [width, height], { timeout: TIMEOUT });
+    await settled().catch(() => fail('no full-size frame within the timeout'));
+    const degS = Number(process.env.SY_ORBIT_DEG_S || 10), secs = Number(process.env.SY_ORBIT_S || 6);
+    const everyMs = Number(process.env.SY_ORBIT_EVERY_MS || 250), held = process.env.SY_ORBIT_HOLD === '1';
+    // the orbit, driven by the page's own display frames; captures kept in the page (window.__caps)
+    const run = await page.evaluate(([degS, secs, everyMs, held]) => new Promise((done) => {
+      const DEG_PER_PX = 0.008 * 180 / Math.PI; // view.js applyInput: 0.008 rad of yaw per pixel
+      const caps = window.__caps = [], cum = [0], id0 = syStats.lastInput;
+      let t0 = null, last = 0, nextCap = 0;
+      if (held) sy.hold(true);
+      function tick(t) {
+        if (t0 === null) { t0 = last = t; nextCap = t + everyMs; requestAnimationFrame(tick); return; }
+        const dx = degS * (t - last) / 1000 / DEG_PER_PX;
+        last = t;
+        sy.input({ t: 'drag', dx: dx, dy: 0, b: 0 });
+        cum.push(cum[cum.length - 1] + dx);
+        if (t >= nextCap) {
+          nextCap += everyMs;
+          const ms = t - t0;
+          sy.capture().then((c) => { c.ms = ms; caps.push(c); });
+        }
+        if (t - t0 < secs * 1000) requestAnimationFrame(tick);
+        else sy.capture().then(() => { if (held) sy.hold(false); done({ id0: id0, cum: cum }); });
+      }
+      requestAnimationFrame(tick);
+    }), [degS, secs, everyMs, held]);
+    await settled().catch(() => fail('no full-size frame answered the orbit'));
+    // each estimate's true frame: a drag back (or on) to its view, then the exact frame of it
+    const png = (name, k) => page.evaluate(async ([name, k]) => {
+      const c = window.__caps[k], src = name === 'est' ? c : c.truth, w = src.w, h = src.h;
+      const img = new ImageData(w, h);
+      for (let y = 0; y < h; y++) img.data.set(src.pixels.subarray((h - 1 - y) * w * 4, (h - y) * w * 4), y * w * 4);
+      const oc = new OffscreenCanvas(w, h);
+      oc.getContext('2d').putImageData(img, 0, 0);
+      const b = new Uint8Array(await (await oc.convertToBlob({ type: 'image/png' })).arrayBuffer());
+      let s = '';
+      for (let i = 0; i < b.length; i += 0x8000) s += String.fromCharCode.apply(null, b.subarray(i, i + 0x8000));
+      return btoa(s);
+    }, [name, k]);
+    const n = await page.evaluate(() => window.__caps.length);
+    const out = [];
+    let at = run.cum.length - 1; // the inputs of the orbit the server's view includes now
+    for (let k = 0; k < n; k++) {
+      const c = await page.evaluate((k) => { const c = window.__caps[k]; return { estimate: c.estimate, input: c.input, unfilled: c.unfilled, yaw: c.orbit.yaw, ms: c.ms, refs: c.refs }; }, k);
+      const i = Math.max(0, Math.min(run.cum.length - 1, c.input - run.id0));
+      const rec = { k, ms: Math.round(c.ms), estimate: c.estimate, unfilled: c.unfilled, yaw: c.yaw, refs: c.refs,
+                    turned_deg: run.cum[i] * 0.008 * 180 / Math.PI };
+      if (c.estimate) {
+        const dx = run.cum[i] - run.cum[at];
+        if (dx) await page.evaluate((dx) => sy.input({ t: 'drag', dx: dx, dy: 0, b: 0 }), dx);
+        at = i;
+        await settled().catch(() => fail(`no full-size frame of capture ${k}'s view`));
+        rec.yaw_true = await page.evaluate(async (k) => { const t = await sy.capture(); window.__caps[k].truth = t; return t.orbit.yaw; }, k);
+        writeFileSync(join(outDir, `est_${k}.png`), Buffer.from(await png('est', k), 'base64'));
+        writeFileSync(join(outDir, `true_${k}.png`), Buffer.from(await png('true', k), 'base64'));
+      }
+      out.push(rec);
+    }
+    const est = out.filter((c) => c.estimate);
+    if (!est.length) fail('no capture was an estimate');
+    if (!process.env.SY_PNG_SSIM) fail('SY_PNG_SSIM (tests/support/png_ssim) is not set');
+    const said = execFileSync(process.env.SY_PNG_SSIM, est.flatMap((c) => [join(outDir, `est_${c.k}.png`), join(outDir, `true_${c.k}.png`)]),
+                              { encoding: 'utf8' }).trim().split('\n');
+    est.forEach((c, i) => { c.ssim = Number(said[i].split(' ')[1]); });
+    const s = est.map((c) => c.ssim).sort((a, b) => a - b), q = (p) => s[Math.min(s.length - 1, Math.floor(p * s.length))];
+    const angle = (a, b) => { const d = Math.abs(a - b) % (2 * Math.PI); return Math.min(d, 2 * Math.PI - d); };
+    const st = await page.evaluate(() => sy.stats());
+    console.log(JSON.stringify({ held, deg_s: degS, secs, estimates: est.length, ssim_median: q(0.5), ssim_p10: q(0.1), ssim_min: s[0],
+                                 unfilled_max: Math.max(...out.map((c) => c.unfilled)), yaw_diff_max: Math.max(...est.map((c) => angle(c.yaw, c.yaw_true))),
+                                 bad: st.bad, server_fps: st.server_fps, stride: st.stride, warp_scale: st.warp_scale, consoleErrors, captures: out }));
   } else if (mode === 'converge') {
     // a still view of a progressive back-end: the canvas early (the first full-size frames) and
     // late (16 times the samples, at least 64): noise, the mean absolute difference of each pixel

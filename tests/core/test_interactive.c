@@ -150,7 +150,7 @@ VIEW_TEST(test_view_without_commit)
     sy_viewport_desc vd = {.root = f->root, .camera = f->cam_node, .backend = "test_plain"};
     CHECK_OK(sy_window_add_viewport(win, &vd, &vp, &e), e);
     CHECK(!sy_viewport_view(vp, NULL));
-    CHECK_OK(sy_interactive_create(0, &ia, &e), e);
+    CHECK_OK(sy_interactive_create(NULL, &ia, &e), e);
     sy_interactive_input in;
     CHECK_OK(sy_interactive_input_init(f->s, f->root, f->cam_node, 32.0f / 24.0f, NULL, 0, &in, &e), e);
 
@@ -205,7 +205,7 @@ VIEW_TEST(test_governor_filter_rgba8)
 {
     sy_error e = {0};
     sy_interactive *ia = NULL;
-    CHECK_OK(sy_interactive_create(10, &ia, &e), e);
+    CHECK_OK(sy_interactive_create(&(sy_governor_desc){.budget_ms = 10}, &ia, &e), e);
     sy_interactive_input in;
     CHECK_OK(sy_interactive_input_init(f->s, f->root, f->cam_node, 1.0f, "soft", 0.5f, &in, &e), e);
     const sy_mediator_class *cls = sy_mediator_find("test_filtering");

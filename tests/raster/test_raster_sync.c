@@ -4,8 +4,10 @@
  * layer, the Cornell walls and floor lit by that light within 20 % of the path tracer and still
  * lit after the light moves (a transform update keeps its area light), parameter errors, and a
  * textured emitter whose texture glows on one half: its area lights are that half (the floor under
- * it as much brighter than under the dark half as the path tracer says). */
+ * it as much brighter than under the dark half as the path tracer says), and frames that do not
+ * depend on the smaller frames drawn before them. */
 #include "it_util.h"
+#include "sy_demo.h"
 #include "sy_gltf.h"
 #include "sy_mediator_raster.h"
 
@@ -284,9 +286,68 @@ static void textured_emitter(void)
     sy_scene_destroy(s);
 }
 
+/* A frame does not depend on the smaller frames before it: the demo (shadow-casting lights, a mirror
+ * sphere's probe, meshes with levels of detail) with its mirror sphere selected, through a window
+ * resized to half size and back after each change (as a web view's moving frame before it refines:
+ * the selection, the sphere hidden, shown again) is bit for bit a fresh window's frame of the
+ * same scene. */
+static void history_free(void)
+{
+    sy_scene *s;
+    MUST(sy_scene_create(&s, err));
+    sy_demo_info d;
+    MUST(sy_demo_build(s, &d, err));
+    MUST(sy_scene_commit(s, NULL, err));
+    enum { FW = 480, FH = 300 };
+    sy_viewport_desc vd = {.root = d.root, .camera = d.camera, .background = d.background, .backend = "raster"};
+    /* the mirror sphere (the demo's root's child of that name) selected */
+    sy_node mirror = {0};
+    uint32_t nc = 0;
+    const uint32_t *ch = sy_node_children(sy_node_get(s, d.root), &nc);
+    for (uint32_t i = 0; i < nc; ++i) {
+        const sy_node_data *nd = sy_node_get(s, (sy_node){ch[i]});
+        if (nd && nd->name && !strcmp(nd->name, "mirror sphere")) mirror.id = ch[i];
+    }
+    EXPECT(mirror.id != 0);
+    MUST(sy_node_set_selected(s, mirror, true, err));
+    MUST(sy_scene_commit(s, NULL, err));
+    sy_layer img[2], small;
+    for (int k = 0; k < 2; ++k) {
+        sy_context_pool *pool;
+        MUST(sy_context_pool_create(&pool, err));
+        sy_window *ww = it_window(FW, FH, &vd, NULL);
+        /* k = 1: hidden, shown again; each change drawn small first (as a web view's moving frame) */
+        for (int step = 0; k == 1 && step < 3; ++step) {
+            if (step) {
+                MUST(sy_node_set_visible(s, mirror, step == 2, err));
+                MUST(sy_scene_commit(s, NULL, err));
+            }
+            MUST(sy_window_resize(ww, FW / 2, FH / 2, err));
+            MUST(sy_layer_create(FW / 2, FH / 2, &small, err));
+            MUST(sy_window_render(ww, s, pool, NULL, &small, err));
+            sy_layer_destroy(&small);
+            MUST(sy_window_resize(ww, FW, FH, err));
+            MUST(sy_layer_create(FW, FH, &small, err));
+            MUST(sy_window_render(ww, s, pool, NULL, &small, err));
+            sy_layer_destroy(&small);
+        }
+        MUST(sy_layer_create(FW, FH, &img[k], err));
+        MUST(sy_window_render(ww, s, pool, NULL, &img[k], err));
+        sy_window_destroy(ww);
+        sy_context_pool_destroy(pool);
+    }
+    size_t n = (size_t)FW * FH, diff = 0;
+    for (size_t i = 0; i < n; ++i) diff += memcmp(img[0].rgba + 4 * i, img[1].rgba + 4 * i, 4 * sizeof(float)) != 0;
+    printf("history: %zu of %zu pixels differ after half-size frames, a hide and a show\n", diff, n);
+    EXPECT_MSG(diff == 0, "a frame after a smaller one differs from a fresh one in %zu pixels", diff);
+    sy_layer_destroy(&img[0]), sy_layer_destroy(&img[1]);
+    sy_scene_destroy(s);
+}
+
 int main(void)
 {
     it_register();
+    history_free();
     incremental();
     cornell();
     textured_emitter();

@@ -86,7 +86,9 @@
     // when the frame arrives: buildMesh), each vertex at its depth along its ray in the reference's
     // camera space (no hit: a direction, at infinity), moved into the current view here; the
     // colour is sampled per fragment at full resolution. Cells across a depth edge are drawn
-    // apart (uSheet): behind everything, they fill only what neither reference covers.
+    // apart (uSheet): behind everything, they fill only what neither reference covers. Cells with
+    // a hit and a miss are not drawn: stretched to the horizon they smeared an object's edge over
+    // what a turn uncovers (DamagedHelmet, docs/WEB.md); the hole fill shows what is behind.
     prog = compile(`
       layout(location = 0) in vec4 aPos; layout(location = 1) in vec2 aUV;
       uniform mat4 uRefToCur; uniform vec4 uCurWin; uniform float uBias; uniform int uSheet;
@@ -94,7 +96,7 @@
       void main() {
         vec4 q = uRefToCur * aPos;
         float z = -q.z, l = uCurWin.x, r = uCurWin.y, b = uCurWin.z, t = uCurWin.w;
-        float dz = uSheet == 1 ? 0.9995 : aPos.w > 0.0 ? clamp(log2(1.0 + max(z, 0.0)) / 48.0 + uBias, 0.0, 0.998) : 0.999;
+        float dz = uSheet == 1 ? 0.9985 : aPos.w > 0.0 ? clamp(log2(1.0 + max(z, 0.0)) / 48.0 + uBias, 0.0, 0.998) : 0.999;
         // the hole fill's depth in alpha: lower is farther (0 = nothing drawn)
         vFar = uSheet == 1 || aPos.w == 0.0 ? 1.0 / 255.0 : 1.0 - clamp(log2(1.0 + max(z, 0.0)) / 24.0, 0.0, 0.99);
         vUV = aUV;
@@ -104,17 +106,17 @@
       }`, `
       uniform sampler2D uColor; in vec2 vUV; in float vFar; out vec4 o;
       void main() { o = vec4(texture(uColor, vUV).rgb, max(vFar, 1.0 / 255.0)); }`);
-    // holes (nothing drawn): on the nearest ring (1, 4, 16, 64 pixels, 8 directions) that has
+    // holes (nothing drawn): on the nearest ring (1, 4, 16, 64, 256, 1024 pixels, 8 directions) that has
     // covered pixels, the mean of the farthest of them (alpha: 0 = hole, else lower = farther): a
     // disocclusion shows what is behind, not the edge of what moved in front
     fillProg = compile(FULL, `
-      uniform sampler2D uWarp; uniform int uShowHoles; uniform float uScale; out vec4 o;
+      uniform sampler2D uWarp; uniform int uShowHoles, uMark; uniform float uScale; out vec4 o;
       void main() {
         ivec2 sz = textureSize(uWarp, 0), p = min(ivec2(gl_FragCoord.xy * uScale), sz - 1);
         vec4 c = texelFetch(uWarp, p, 0);
         if (c.a > 0.0) { o = vec4(texture(uWarp, gl_FragCoord.xy * uScale / vec2(sz)).rgb, 1.0); return; }
         vec3 sum = vec3(0.0); float n = 0.0;
-        for (int r = 1; r <= 64 && n == 0.0; r *= 4) {
+        for (int r = 1; r <= 1024 && n == 0.0; r *= 4) {
           vec4 s[8]; float amin = 2.0;
           for (int k = 0; k < 8; k++) {
             ivec2 d = ivec2(k == 0 || k == 1 || k == 7 ? 1 : (k == 3 || k == 4 || k == 5 ? -1 : 0),
@@ -126,7 +128,8 @@
             if (s[k].a > 0.0 && s[k].a <= amin + 3.0 / 255.0) { sum += s[k].rgb; n += 1.0; }
         }
         vec3 f = n > 0.0 ? sum / n : vec3(0.0);
-        o = vec4(uShowHoles == 1 ? mix(f, vec3(1.0, 0.0, 1.0), 0.5) : f, 1.0);
+        // uMark (sy.capture): alpha 0 where no ring found a covered pixel (the fill left a hole)
+        o = vec4(uShowHoles == 1 ? mix(f, vec3(1.0, 0.0, 1.0), 0.5) : f, uMark == 1 && n == 0.0 ? 0.0 : 1.0);
       }`);
     // the exact frame: scaled to the canvas
     blitProg = compile(FULL, `
@@ -294,7 +297,7 @@
   }
   // the reference's mesh: grid points every s pixels (camera space: (tx d, ty d, -d, 1), no hit
   // (tx, ty, -1, 0)) and their texture coordinates; the cells' triangles, those across a depth
-  // edge (corners more than 5% apart, or hit and not hit) after the others
+  // edge (corners more than 5% apart) after the others, none for a cell of hits and misses
   function buildMesh(depth, w, h, win, s) {
     s = Math.max(1, Math.min(s, w - 1, h - 1));
     const cols = Math.max(1, Math.ceil((w - 1) / s)), rows = Math.max(1, Math.ceil((h - 1) / s)), gx = cols + 1, gy = rows + 1;
@@ -316,10 +319,11 @@
     for (let j = 0; j < rows; j++) for (let i = 0; i < cols; i++) {
       const p = j * gx + i, q = [p, p + 1, p + gx, p + 1, p + gx + 1, p + gx];
       const c = [dd[p], dd[p + 1], dd[p + gx], dd[p + gx + 1]], lo = Math.min(...c), hi = Math.max(...c);
-      if (hi > 0 && (lo <= 0 || hi > lo * 1.05)) { b -= 6; idx.set(q, b); } else { idx.set(q, a); a += 6; }
+      if (hi > 0 && lo <= 0) continue; // a hit beside a miss: a sheet would stretch it to the horizon
+      if (hi > lo * 1.05) { b -= 6; idx.set(q, b); } else { idx.set(q, a); a += 6; }
     }
-    // the sheet cells were written from the end: solid [0, a), sheet [b, end) with b === a
-    const m = { vao: gl.createVertexArray(), vbo: gl.createBuffer(), ibo: gl.createBuffer(), solid: a, sheet: idx.length - a };
+    // the sheet cells were written from the end: solid [0, a), sheet [b, end)
+    const m = { vao: gl.createVertexArray(), vbo: gl.createBuffer(), ibo: gl.createBuffer(), solid: a, sheet: idx.length - b, sheetAt: b };
     gl.bindVertexArray(m.vao);
     gl.bindBuffer(gl.ARRAY_BUFFER, m.vbo);
     gl.bufferData(gl.ARRAY_BUFFER, v, gl.STATIC_DRAW);
@@ -439,19 +443,26 @@
       gl.uniform1i(prog.u.uSheet, 0);
       gl.drawElements(gl.TRIANGLES, r.mesh.solid, gl.UNSIGNED_INT, 0);
       gl.uniform1i(prog.u.uSheet, 1);
-      if (r.mesh.sheet) gl.drawElements(gl.TRIANGLES, r.mesh.sheet, gl.UNSIGNED_INT, 4 * r.mesh.solid);
+      if (r.mesh.sheet) gl.drawElements(gl.TRIANGLES, r.mesh.sheet, gl.UNSIGNED_INT, 4 * r.mesh.sheetAt);
       gl.bindVertexArray(vao);
     });
     gl.disable(gl.DEPTH_TEST);
-    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
-    gl.viewport(0, 0, cw, ch);
-    gl.useProgram(fillProg.p);
-    gl.uniform1f(fillProg.u.uScale, fw / cw);
-    gl.activeTexture(gl.TEXTURE0); gl.bindTexture(gl.TEXTURE_2D, fboColor);
-    gl.uniform1i(fillProg.u.uWarp, 0); gl.uniform1i(fillProg.u.uShowHoles, showHoles ? 1 : 0);
-    gl.drawArrays(gl.TRIANGLES, 0, 3);
+    fill(null, false);
     estimate = 1;
     return inputId; // every input sent so far is in the local orbit
+  }
+  // the hole fill: the warp (fboColor) scaled to the canvas into target (null: the canvas); mark:
+  // alpha 0 where it found nothing to fill with (sy.capture)
+  function fill(target, mark) {
+    gl.bindFramebuffer(gl.FRAMEBUFFER, target);
+    gl.viewport(0, 0, canvas.width, canvas.height);
+    gl.useProgram(fillProg.p);
+    gl.uniform1f(fillProg.u.uScale, fboW / canvas.width);
+    gl.activeTexture(gl.TEXTURE0); gl.bindTexture(gl.TEXTURE_2D, fboColor);
+    gl.uniform1i(fillProg.u.uWarp, 0); gl.uniform1i(fillProg.u.uShowHoles, showHoles ? 1 : 0);
+    gl.uniform1i(fillProg.u.uMark, mark ? 1 : 0);
+    gl.drawArrays(gl.TRIANGLES, 0, 3);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
   }
   // the warp adapts to what the display frames cost: a level is the mesh density (a vertex every
   // stride pixels; meshes built from then on) and the warp's resolution (its share of the canvas,
@@ -459,11 +470,14 @@
   // refreshes or more (> 34 ms), up while one refresh (< 20 ms) is enough
   const LEVELS = [{ stride: 2, scale: 1 }, { stride: 4, scale: 1 }, { stride: 4, scale: 0.5 },
                   { stride: 8, scale: 0.5 }, { stride: 8, scale: 0.25 }];
-  let level = 1, stride = LEVELS[level].stride, lastWarped = false;
+  // ?level=N (measurements): the warp held at level N (0..4), not adapted
+  const fixedLevel = /^[0-4]$/.test(params.get("level") || "") ? Number(params.get("level")) : -1;
+  let level = fixedLevel >= 0 ? fixedLevel : 1, stride = LEVELS[level].stride, lastWarped = false;
   function frame(t) {
     if (lastT) {
       keep(hist.frame, t - lastT, 240); frameCount++;
-      if (lastWarped && t - lastT > 34 && level < LEVELS.length - 1) level++;
+      if (fixedLevel >= 0) level = fixedLevel;
+      else if (lastWarped && t - lastT > 34 && level < LEVELS.length - 1) level++;
       else if (lastWarped && t - lastT < 20 && level > 0) level--;
       stride = LEVELS[level].stride;
     }
@@ -480,10 +494,11 @@
         waiting.splice(i, 1);
       } else i++;
     }
-    if ((newFrame || moved) && refs.length) {
+    if ((newFrame || moved || captures.length) && refs.length) {
       drawnInput = Math.max(drawnInput, draw());
       drawnServer = Math.max(drawnServer, refs[0].answered);
       shownInput = drawnInput;
+      if (captures.length && gl) capture();
     } else if (!gl && newFrame) {
       drawnServer = drawnInput = stats.answeredInput;
     }
@@ -495,6 +510,38 @@
   requestAnimationFrame(frame);
 
   // ---- window.sy: measurable from outside (docs/WEB.md) ----
+  // sy.capture (browser.mjs orbit): the display frame just drawn, read back before the browser
+  // shows it: RGBA at the canvas' size (rows bottom-up), whether it is an estimate, the view it
+  // shows (the local orbit, or the frame's), the newest input it answers and the share of the
+  // canvas the hole fill left empty (an estimate's fill drawn again into capFbo, marking them)
+  const captures = [];
+  let capFbo = null, capTex = null, capW = 0, capH = 0;
+  function capture() {
+    const cw = canvas.width, ch = canvas.height, px = new Uint8Array(cw * ch * 4);
+    let unfilled = 0;
+    if (estimate) {
+      if (!capFbo || capW !== cw || capH !== ch) {
+        if (capFbo) { gl.deleteFramebuffer(capFbo); gl.deleteTexture(capTex); }
+        capFbo = gl.createFramebuffer(); capTex = gl.createTexture();
+        gl.bindTexture(gl.TEXTURE_2D, capTex);
+        gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA8, cw, ch);
+        gl.bindFramebuffer(gl.FRAMEBUFFER, capFbo);
+        gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, capTex, 0);
+        capW = cw; capH = ch;
+      }
+      fill(capFbo, true);
+      gl.bindFramebuffer(gl.FRAMEBUFFER, capFbo);
+      gl.readPixels(0, 0, cw, ch, gl.RGBA, gl.UNSIGNED_BYTE, px);
+      gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+      for (let i = 3; i < px.length; i += 4) if (!px[i]) { unfilled++; px[i] = 255; }
+    } else {
+      gl.readPixels(0, 0, cw, ch, gl.RGBA, gl.UNSIGNED_BYTE, px);
+    }
+    const c = { w: cw, h: ch, pixels: px, estimate: estimate, orbit: estimate ? localOrbit() : refs[0].orbit,
+                input: drawnInput, unfilled: unfilled / (cw * ch),
+                refs: refs.map(function (r) { return { w: r.w, h: r.h, yaw: r.orbit.yaw, pitch: r.orbit.pitch }; }) };
+    for (const r of captures.splice(0)) r(c);
+  }
   function holeShare() { // read back on demand: the pixels no reference point landed on
     if (!gl || !fbo || !estimate) return 0;
     const px = new Uint8Array(fboW * fboH * 4);
@@ -520,6 +567,8 @@
     },
     // tests: keep the references (frames arriving are dropped); released, the page asks for a frame
     hold: function (on) { hold = !!on; if (!hold) sendSize(); },
+    // tests: a promise of the next display frame, drawn and read back (capture above)
+    capture: function () { return new Promise(function (r) { captures.push(r); }); },
     // for the page's other scripts (ui.js, tree.js, ...): send a message, an input (the camera's
     // are predicted by the warp), listen to the server's text messages, and where a world point
     // is on the canvas now (CSS pixels; null when behind the camera or before the first frame)
