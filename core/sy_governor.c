@@ -162,6 +162,12 @@ void sy_governor_reset(sy_governor *g)
 
 void sy_governor_redraw(sy_governor *g) { g->redraw = true; }
 
+void sy_governor_set_min_scale(sy_governor *g, float min_scale)
+{
+    if (!(min_scale >= 0.0f && min_scale <= 1.0f)) return;
+    g->d.min_scale = min_scale == 0.0f ? GOV_DEFAULT_MIN_SCALE : min_scale;
+}
+
 bool sy_governor_cost(const sy_governor *g, bool moving, double *fixed_ms, double *per_ms)
 {
     const gov_fit *f = &g->fit[moving ? FIT_PLAIN : FIT_REFINE];

@@ -93,6 +93,9 @@ void sy_governor_plan(sy_governor *g, uint32_t display_w, uint32_t display_h, ui
 void sy_governor_report(sy_governor *g, const sy_governor_frame *f, double render_ms);
 /** Back-end switched: forget the cost model; the next plan starts over as after a view change. */
 void sy_governor_reset(sy_governor *g);
+/** Sets the smallest resolution scale from the next plan on (as sy_governor_desc.min_scale: (0, 1],
+ * 0 = 0.125; a value outside [0, 1] or NaN leaves it as it is). */
+void sy_governor_set_min_scale(sy_governor *g, float min_scale);
 /** Something shown changed that keeps the view and the back-end's accumulation (a display filter):
  * when the governor is idle, the next plan gives one more refining frame (1 sample). */
 void sy_governor_redraw(sy_governor *g);

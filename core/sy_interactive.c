@@ -208,6 +208,11 @@ void sy_interactive_set_temporal(sy_interactive *ia, bool on)
     ia->temporal = on;
 }
 
+void sy_interactive_set_min_scale(sy_interactive *ia, float min_scale)
+{
+    sy_governor_set_min_scale(ia->gov, min_scale);
+}
+
 bool sy_interactive_view_matrix(const sy_interactive *ia, sy_mat4 *camera_to_world)
 {
     if (ia->planned) *camera_to_world = ia->view;

@@ -118,6 +118,10 @@ bool sy_interactive_view_matrix(const sy_interactive *ia, sy_mat4 *camera_to_wor
  * history instead of its few noisy samples, and a still view shows the accumulation unchanged. */
 void sy_interactive_set_temporal(sy_interactive *ia, bool on);
 
+/** The governor's smallest resolution scale from the next plan on (sy_governor_set_min_scale; 0: the
+ * governor's default): sy web raises it while every viewer's page warps. */
+void sy_interactive_set_min_scale(sy_interactive *ia, float min_scale);
+
 /** Applies display filter `filter` (index) at threshold to the back-end's context in pool (made
  * there when missing, for root_id), when the filter, its version or enabled changed or the context is
  * new; enabled false turns it off (the governor does while the view moves). A back-end without

@@ -154,11 +154,13 @@ sy_result sy_web_create(const sy_web_desc *desc, sy_web **out, sy_error *err)
     if (r == SY_OK && (w->d.max_width > 16384 || w->d.max_height > 16384 || w->d.max_clients > 1000 || w->d.max_message < 64 ||
         w->d.max_message > (1u << 24) || w->d.quality < 1 || w->d.quality > 100 || w->d.idle_timeout_s > 3600 ||
         !(w->d.budget_ms >= 0 && w->d.budget_ms <= 1e5) || w->d.still_max_pixels > (uint64_t)SY_JPEG_MAX_SIDE * SY_JPEG_MAX_SIDE ||
-        w->d.max_pending > 1024 || w->d.head_timeout_ms > 600000 || w->d.still_deadline_ms > 600000 || w->d.delay_ms > 10000))
+        w->d.max_pending > 1024 || w->d.head_timeout_ms > 600000 || w->d.still_deadline_ms > 600000 || w->d.delay_ms > 10000 ||
+        !(w->d.min_scale > 0.0f && w->d.min_scale <= 1.0f)))
         r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT,
                          "web: a limit is out of range (frame <= 16384, clients <= 1000, message 64..16 MiB, quality "
                          "1..100, idle timeout <= 3600 s, budget 0..1e5 ms, still pixels <= 16384^2, pending "
-                         "connections <= 1024, head timeout and still deadline <= 600 s, delay <= 10000 ms)");
+                         "connections <= 1024, head timeout and still deadline <= 600 s, delay <= 10000 ms, min_scale "
+                         "in (0, 1])");
     if (r == SY_OK) r = parse_listen(desc->listen ? desc->listen : "127.0.0.1:8080", w->host, sizeof w->host, &w->port, err);
     if (r == SY_OK && desc->route_count) {
         w->routes = calloc(desc->route_count, sizeof *w->routes);

@@ -47,12 +47,13 @@
 extern "C" {
 #endif
 
-/** The default smallest resolution of a moving frame (sy_web_desc.min_scale, sy web --min-scale):
- * half the display's side, not the governor's eighth. The page answers every input itself by
- * warping the last frames, so a frame's detail counts for more than the server's frame rate
- * (docs/WEB.md, "The estimate during an orbit": DamagedHelmet's estimate SSIM 0.80-0.82 with the
- * governor's 60 x 45 moving frames, 0.89 with 240 x 180, at the same 2.5 frames a second on the
- * 2-core machine) */
+/** The default smallest resolution of a moving frame while every viewer's page warps
+ * (sy_web_desc.min_scale, sy web --min-scale): half the display's side, not the governor's eighth.
+ * Such a page answers every input itself by warping the last frames, so a frame's detail counts for
+ * more than the server's frame rate (docs/WEB.md, "The estimate during an orbit": DamagedHelmet's
+ * estimate SSIM 0.80-0.82 with the governor's 60 x 45 moving frames, 0.89 with 240 x 180, at the
+ * same 2.5 frames a second on the 2-core machine). Viewers that do not warp (a page without
+ * WebGL2, ?warp=0, other clients) keep the governor's floor for all. */
 #define SY_WEB_MIN_SCALE 0.5f
 
 /** A request given to a route handler (valid during the call). */
@@ -106,8 +107,8 @@ typedef struct sy_web_desc {
     int quality;              /**< quality of streamed frames, 1..100 (default 80; stills: JPEG 95): JPEG's, and
                                *   the video stream's quantizer through sy_web_video_quantizer (80: 36) */
     double budget_ms;         /**< frame-time budget of the governor while the view moves (default 33) */
-    float min_scale;          /**< smallest resolution of a moving frame, a share of the display's side (0, 1];
-                               *   0: SY_WEB_MIN_SCALE */
+    float min_scale;          /**< smallest resolution of a moving frame while every viewer warps, a share of the
+                               *   display's side (0, 1]; 0: SY_WEB_MIN_SCALE */
     uint32_t still_samples;   /**< samples per pixel of a progressive back-end's still (default 16) */
     uint32_t idle_timeout_s;  /**< a silent WebSocket is pinged, then closed after twice this (default 30) */
     const char *filter;       /**< initial display filter of a back-end with SY_CAP_FILTERS (NULL: none) */

@@ -514,6 +514,9 @@ sy_result sy_web_parse_input(const char *text, size_t len, sy_web_input *out, sy
         else if (cJSON_GetObjectItemCaseSensitive(m, "v") && (!json_num(m, "v", 0, 1000, &ver) || ver != floor(ver)))
             r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "size: v must be a whole number 0..1000");
         out->version = (uint32_t)ver;
+        const cJSON *wp = cJSON_GetObjectItemCaseSensitive(m, "warp");
+        if (r == SY_OK && wp && !cJSON_IsBool(wp)) r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "size: warp must be true or false");
+        out->warp = cJSON_IsTrue(wp);
         if (r == SY_OK) parse_codecs(cJSON_GetObjectItemCaseSensitive(m, "codecs"), out);
     } else if (!strcmp(type, "keyframe")) {
         out->type = SY_WEB_INPUT_KEYFRAME;

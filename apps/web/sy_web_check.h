@@ -171,6 +171,7 @@ typedef struct sy_web_input {
     char key;        /**< key: '1'..'9', 'f', '[', ']', 'r' (lower case) */
     uint32_t version; /**< size: the frame format the page reads ("v", 0..1000; 0 = absent: a page
                        * older than frame format 3, refused with a status message) */
+    bool warp;       /**< size: the page warps its last frames to each input ("warp": true; absent: false) */
     uint32_t node;   /**< visible, select, isolate: the node id (0 only for select / isolate: all);
                       * tree: the node whose children are listed (0 or absent: the scene's roots) */
     uint32_t slot;   /**< view: the saved view's number, 1..SY_BOOKMARKS_MAX */

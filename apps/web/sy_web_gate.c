@@ -10,6 +10,7 @@
 #include <fcntl.h>
 #include <netdb.h>
 #include <netinet/in.h>
+#include <netinet/tcp.h>
 #include <poll.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -210,6 +211,11 @@ static void *gate_main(void *p)
                 socklen_t sl = sizeof sa;
                 int fd = accept4(g->listen_fd, (struct sockaddr *)&sa, &sl, SOCK_NONBLOCK | SOCK_CLOEXEC);
                 if (fd < 0) break;
+                /* no Nagle: libwebsockets writes a frame in 4 KiB pieces, and the last one waited
+                 * for the ACK of the one before, which the viewer delays 40 ms (sy bench web at
+                 * 640 x 400: 42 ms of every answer, 0.3 ms without) */
+                int one = 1;
+                setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
                 accept_one(g, fd, &sa);
             }
     }

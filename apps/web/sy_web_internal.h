@@ -152,6 +152,8 @@ struct sy_web {
     uint32_t clients;
     uint32_t video_viewers, jpeg_viewers; /* sized viewers by what they are sent: the render thread
                                            * keeps a frame's pixels for the first, JPEG for the second */
+    uint32_t plain_viewers; /* sized viewers whose page does not warp: moving frames at the governor's
+                             * own floor while there is one, else at d.min_scale */
     double encode_per_px_ms; /* the network thread's encoders, summed over viewers (ms per pixel of a
                               * frame, sy_web_cost.h): the render thread adds it to a frame's cost */
     bool need_pixels; /* a video viewer was sent a frame without pixels: the render thread republishes

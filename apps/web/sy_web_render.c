@@ -492,7 +492,7 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
     if (r == SY_OK) r = sy_window_create(64, 64, &rs.still_win, err);
     if (r == SY_OK) r = sy_window_add_viewport(rs.still_win, &vd, &rs.still_vp, err);
     if (r == SY_OK)
-        r = sy_interactive_create(&(sy_governor_desc){.budget_ms = w->d.budget_ms, .min_scale = w->d.min_scale}, &rs.ia, err);
+        r = sy_interactive_create(&(sy_governor_desc){.budget_ms = w->d.budget_ms}, &rs.ia, err);
     if (r == SY_OK) sy_interactive_set_temporal(rs.ia, !w->d.no_temporal);
     rs.backend_applied = w->initial_backend;
     if (r == SY_OK) warm_up(w, &rs);
@@ -538,6 +538,9 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
         uint32_t bi = w->backend, dw = w->display_w, dh = w->display_h;
         uint64_t gen = w->input_gen;
         bool clients = w->clients > 0 && w->display_w > 0;
+        /* moving frames keep d.min_scale of the display while every viewer's page warps (it answers
+         * inputs itself: detail counts for more than rate), else the governor's own floor */
+        float floor_scale = w->plain_viewers ? 0.0f : w->d.min_scale;
         bool need_pixels = w->need_pixels;
         w->need_pixels = false;
         float fov_req = w->fov_req; /* a recalled view's field of view (sy_web_views.c) */
@@ -563,6 +566,7 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
             if (sy_webi_scene_actions(&sc, actions)) rs.changed = moved = true;
         }
         bool due = again || (wait_until > 0 && sy_time_now() * 1e3 >= wait_until);
+        sy_interactive_set_min_scale(rs.ia, floor_scale);
         if (clients && (moved || due)) render_live(w, &rs, &in, bi, dw, dh, gen, &again, &wait_until);
         /* after render_live, which may have rendered nothing (a view at rest) */
         if (need_pixels) republish_with_pixels(w, &rs);

@@ -72,6 +72,7 @@ struct web_conn {
     double cost_in_sum;       /* and its share of w->encode_per_px_ms */
     uint32_t last_backend;
     int kind;                 /* counted in w->video_viewers (2), jpeg_viewers (1) or neither (0) */
+    bool plain;               /* counted in w->plain_viewers: sized, and its page does not warp */
     uint64_t v_frames, v_keys, v_bytes;
     double v_psnr;            /* sum over v_frames */
 };
@@ -90,6 +91,15 @@ static void set_kind(sy_web *w, web_conn *c, int kind)
     c->kind = kind;
     if (kind == 2) w->video_viewers++;
     if (kind == 1) w->jpeg_viewers++;
+}
+
+/* Counts c among the sized viewers whose page does not warp (plain) or not: moving frames keep
+ * sy_web_desc.min_scale of the display only while there is none. Call with w->mu held. */
+static void set_plain(sy_web *w, web_conn *c, bool plain)
+{
+    if (c->plain) w->plain_viewers--;
+    c->plain = plain;
+    if (plain) w->plain_viewers++;
 }
 
 static void video_summary(web_conn *c, const char *when)
@@ -304,6 +314,8 @@ static void ws_message(sy_web *w, web_conn *c, const char *text, size_t len)
         if (!c->sized || w->display_w != (uint32_t)in.a || w->display_h != (uint32_t)in.b) w->view_version++;
         c->old_page = false, c->sized = true;
         set_kind(w, c, c->codec == SY_WEB_CODEC_JPEG ? 1 : 2);
+        if (c->plain == in.warp) w->view_version++; /* the moving frames' floor may change */
+        set_plain(w, c, !in.warp);
         w->display_w = (uint32_t)in.a, w->display_h = (uint32_t)in.b;
         break;
     case SY_WEB_INPUT_DRAG: sy_interactive_drag(&w->in, in.button >= 1 ? 1 : 0, (float)in.a, (float)in.b); break;
@@ -763,6 +775,7 @@ static int ws_callback(struct lws *wsi, enum lws_callback_reasons reason, void *
                 w->clients--;
                 drop_replies_locked(w, c->serial); /* its answers go with it (actions still queued answer nobody) */
                 set_kind(w, c, 0);
+                set_plain(w, c, false);
                 pthread_mutex_unlock(&w->mu);
                 video_summary(c, "");
                 sy_log(SY_LOG_NOTE, "web", c->peer, "viewer left");

@@ -34,6 +34,11 @@ int test_stream(uint16_t port)
         }
     CHECK(hits > 80 * 60 / 10 && fi.depth_min > 0); /* the demo fills much of the view */
     free(depth);
+    /* the server's sockets send at once (TCP_NODELAY): without it the last piece of a frame over
+     * 4 KiB waited 40 ms for the viewer's delayed ACK (sy bench web: 42 ms of every answer) */
+    int socks = 0, nodelay = 0;
+    web_server_sockets(port, &socks, &nodelay);
+    CHECK_MSG(socks >= 2 && nodelay == socks, "%d of the server's %d connections have TCP_NODELAY", nodelay, socks);
     /* a page that reads frame format 2 (format 1: no "v" in its size message, the same path) is
      * told to reload and gets no frames, while this viewer's input gives it new ones */
     sy_web_client *old = NULL;
@@ -122,6 +127,64 @@ int test_stream(uint16_t port)
     CHECK(sy_web_client_connect(&o, 10000, &c, &err) == SY_ERR_PROTOCOL);
     for (int i = 0; i < 3; ++i) sy_web_client_close(v[i]);
     return 0;
+}
+
+/* the widths of the frames answering n drags sent one at a time by c (ids from *id on) into wd */
+static int drag_widths(sy_web_client *c, uint64_t *id, int n, uint32_t *wd)
+{
+    sy_error err = {0};
+    sy_web_frame_info fi;
+    for (int k = 0; k < n; ++k) {
+        char m[96];
+        ++*id;
+        snprintf(m, sizeof m, "{\"t\":\"drag\",\"dx\":2,\"dy\":0,\"id\":%llu}", (unsigned long long)*id);
+        CHECK_OK(sy_web_client_send(c, m, &err), err);
+        do {
+            if (web_next_frame(c, &fi, NULL, NULL)) return 1;
+        } while (fi.input_id < *id);
+        wd[k] = fi.width;
+    }
+    return 0;
+}
+
+/* web_warpfloor: moving frames keep sy_web_desc.min_scale (SY_WEB_MIN_SCALE, 0.5) of the display
+ * while every viewer's page warps, the governor's own floor (0.125) while one does not; a budget of
+ * 0.01 ms, which every frame overruns, puts the governor at the floor */
+int test_warp_floor(void)
+{
+    sy_error err = {0};
+    server s;
+    web_budget_ms = 0.01;
+    if (web_start(&s, "127.0.0.1:0", "whitted", &err)) return 1;
+    sy_web_client *c = NULL, *d = NULL;
+    sy_web_client_opts o = {.host = "127.0.0.1", .port = sy_web_port(s.web), .path = "/ws"};
+    CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"size\",\"w\":160,\"h\":100,\"v\":3,\"warp\":true}", &err), err);
+    sy_web_frame_info fi;
+    do {
+        CHECK_OK(sy_web_client_next_frame(c, 60000, &fi, NULL, NULL, &err), err);
+    } while (fi.width != 160);
+    uint64_t id = 0;
+    uint32_t wd[6];
+    if (drag_widths(c, &id, 6, wd)) return 1;
+    printf("warpfloor: a warping viewer's moving frames %u %u %u %u %u %u of 160\n", wd[0], wd[1], wd[2], wd[3], wd[4], wd[5]);
+    for (int k = 2; k < 6; ++k) CHECK_MSG(wd[k] == 80, "a warping viewer's moving frame %u wide, not 80", wd[k]);
+    /* a second viewer that does not warp (no "warp"): the governor's floor for both */
+    CHECK_OK(sy_web_client_connect(&o, 10000, &d, &err), err);
+    CHECK_OK(sy_web_client_send(d, "{\"t\":\"size\",\"w\":160,\"h\":100,\"v\":3}", &err), err);
+    if (drag_widths(c, &id, 6, wd)) return 1;
+    printf("warpfloor: with a viewer that does not warp %u %u %u %u %u %u of 160\n", wd[0], wd[1], wd[2], wd[3], wd[4], wd[5]);
+    for (int k = 3; k < 6; ++k) CHECK_MSG(wd[k] == 20, "with a viewer that does not warp: %u wide, not 20", wd[k]);
+    /* "warp" that is no boolean: refused (logged), nothing changes; that viewer leaves: half again */
+    CHECK_OK(sy_web_client_send(d, "{\"t\":\"size\",\"w\":160,\"h\":100,\"v\":3,\"warp\":1}", &err), err);
+    if (drag_widths(c, &id, 4, wd)) return 1;
+    CHECK_MSG(wd[3] == 20, "after a size with \"warp\":1 (refused): %u wide, not 20", wd[3]);
+    sy_web_client_close(d);
+    if (drag_widths(c, &id, 6, wd)) return 1;
+    for (int k = 3; k < 6; ++k) CHECK_MSG(wd[k] == 80, "the viewer that did not warp gone: %u wide, not 80", wd[k]);
+    sy_web_client_close(c);
+    web_budget_ms = 0;
+    return web_stop(&s);
 }
 
 /* the path tracer refines while the view rests (samples grow frame after frame) and restarts

@@ -151,6 +151,23 @@ static sy_result add_shrink_clip(sy_scene *s, sy_animation *shrink, sy_error *e)
 }
 
 bool web_big_tree;
+double web_budget_ms; /* web_warpfloor: a budget every frame overruns */
+
+void web_server_sockets(uint16_t port, int *n, int *nodelay)
+{
+    *n = *nodelay = 0;
+    for (int fd = 3; fd < 1024; ++fd) {
+        struct sockaddr_storage a, p;
+        socklen_t al = sizeof a, pl = sizeof p;
+        int type = 0, on = 0;
+        socklen_t tl = sizeof type, ol = sizeof on;
+        if (getsockopt(fd, SOL_SOCKET, SO_TYPE, &type, &tl) != 0 || type != SOCK_STREAM) continue;
+        if (getsockname(fd, (struct sockaddr *)&a, &al) != 0 || a.ss_family != AF_INET) continue;
+        if (ntohs(((struct sockaddr_in *)&a)->sin_port) != port || getpeername(fd, (struct sockaddr *)&p, &pl) != 0) continue;
+        (*n)++;
+        if (getsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &on, &ol) == 0 && on) (*nodelay)++;
+    }
+}
 
 /* A group named name under parent with count children named "name i", set at once. */
 static sy_result add_group(sy_scene *s, sy_node parent, const char *name, uint32_t count, sy_error *e)
@@ -199,6 +216,7 @@ int web_start(server *s, const char *listen, const char *backend, sy_error *e)
                          .backend = backend, .listen = listen, .max_body = 1000, .max_message = 256, .max_clients = 3,
                          .routes = routes, .route_count = 3, .read_only = web_read_only, .bookmarks = web_bookmarks,
                          .still_max_pixels = 20000, /* small stills: fast on a loaded machine */
+                         .budget_ms = web_budget_ms,
                          .clip = shrink}; /* web_timeline: the server's clock plays shrink alone */
         failed = sy_web_create(&d, &s->web, e) != SY_OK;
     }

@@ -28,6 +28,7 @@
 #include <arpa/inet.h>
 #include <math.h>
 #include <netinet/in.h>
+#include <netinet/tcp.h>
 #include <poll.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -75,6 +76,8 @@ extern bool web_read_only_anim;
 /* web_tree: the demo's root gets a group "flat" of 12,000 children and a group "deep" of 20 groups
  * of 300 children each (18,022 nodes more). */
 extern bool web_big_tree;
+/* web_warpfloor: the governor's budget of the server web_start() makes (ms; 0: the default). */
+extern double web_budget_ms;
 /* The demo scene served on listen by backend from a thread of its own, with the test routes
  * GET /api/object/ (path and query), POST /api/echo (body length and byte sum) and GET /api/block
  * (below); 1 after printing why not. */
@@ -107,6 +110,10 @@ int test_progressive(void);
 int test_frame(void);
 int test_video_stream(uint16_t port);
 int test_encode_cost(void);
+int test_warp_floor(void);
+/* The server's connections in this process (TCP sockets whose local port is port and that have a
+ * peer): how many there are into *n, and how many of them have TCP_NODELAY into *nodelay. */
+void web_server_sockets(uint16_t port, int *n, int *nodelay);
 /* test_web_guard.c */
 int test_token(void);
 int test_hostile(uint16_t port);

@@ -614,7 +614,7 @@
     canvas.width = w; canvas.height = h;
     asked.w = Math.max(asked.w, w); asked.h = Math.max(asked.h, h);
     moved = true;
-    send({ t: "size", w: w, h: h, v: FORMAT, codecs: video ? video.codecs : undefined });
+    send({ t: "size", w: w, h: h, v: FORMAT, warp: warpOn && !!gl, codecs: video ? video.codecs : undefined });
     mark("sy-size");
   }
   // the first picture's path, as performance marks (once each; tests/browser/first_picture.sh)
