@@ -86,7 +86,8 @@
     // when the frame arrives: buildMesh), each vertex at its depth along its ray in the reference's
     // camera space (no hit: a direction, at infinity), moved into the current view here; the
     // colour is sampled per fragment at full resolution. Cells across a depth edge are drawn
-    // apart (uSheet): behind everything, they fill only what neither reference covers. Cells with
+    // apart (uSheet): behind every surface but in front of the sky (behind it, an object's side
+    // seen at a grazing angle vanished), they fill only what neither reference covers. Cells with
     // a hit and a miss are not drawn: stretched to the horizon they smeared an object's edge over
     // what a turn uncovers (DamagedHelmet, docs/WEB.md); the hole fill shows what is behind.
     prog = compile(`
