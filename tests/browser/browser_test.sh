@@ -369,7 +369,7 @@ if [ "$mode" = orbit ]; then
       const n = r.captures.length, est = r.captures.filter((c) => c.estimate);
       console.log(`held orbit of ${Math.max(...r.captures.map((c) => c.turned_deg)).toFixed(1)} degrees: ${est.length} of ${n} captures ` +
                   `estimates; SSIM against the true frames median ${r.ssim_median} min ${r.ssim_min}; largest share left unfilled ${r.unfilled_max}`);
-      if (!(n >= 5)) errs.push(`only ${n} captures`);
+      if (!(n >= 3)) errs.push(`only ${n} captures`);
       if (est.length !== n) errs.push(`${n - est.length} captures were no estimate though the references were held`);
       if (!(r.unfilled_max === 0)) errs.push(`the hole fill left ${(100 * r.unfilled_max).toFixed(2)}% of a canvas empty`);
       if (!(r.ssim_min >= 0.88)) errs.push(`an estimate has SSIM ${r.ssim_min} < 0.88 against its true frame`);
