@@ -441,8 +441,11 @@ try {
     const est = out.filter((c) => c.estimate);
     if (!est.length) fail('no capture was an estimate');
     if (!process.env.SY_PNG_SSIM) fail('SY_PNG_SSIM (tests/support/png_ssim) is not set');
-    const said = execFileSync(process.env.SY_PNG_SSIM, est.flatMap((c) => [join(outDir, `est_${c.k}.png`), join(outDir, `true_${c.k}.png`)]),
-                              { encoding: 'utf8' }).trim().split('\n');
+    let said;
+    try {
+      said = execFileSync(process.env.SY_PNG_SSIM, est.flatMap((c) => [join(outDir, `est_${c.k}.png`), join(outDir, `true_${c.k}.png`)]),
+                          { encoding: 'utf8' }).trim().split('\n');
+    } catch (e) { fail(`png_ssim: ${String(e.stderr || e.message).trim()}`); }
     est.forEach((c, i) => { c.ssim = Number(said[i].split(' ')[1]); });
     const s = est.map((c) => c.ssim).sort((a, b) => a - b), q = (p) => s[Math.min(s.length - 1, Math.floor(p * s.length))];
     const angle = (a, b) => { const d = Math.abs(a - b) % (2 * Math.PI); return Math.min(d, 2 * Math.PI - d); };
