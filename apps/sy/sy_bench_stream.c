@@ -55,11 +55,6 @@ static void luma_f(const float *rgba, size_t n, float *out)
     }
 }
 
-static void luma_8(const uint8_t *px, size_t n, float *out)
-{
-    for (size_t i = 0; i < n; ++i) out[i] = (0.2126f * px[4 * i] + 0.7152f * px[4 * i + 1] + 0.0722f * px[4 * i + 2]) / 255.0f;
-}
-
 /* format 2's depth channel (docs/WEB.md before format 3): every pixel's 16-bit log depth as row
  * deltas, byte planes, deflate level 1; its bytes (0 on failure) */
 static size_t format2_depth_bytes(const float *depth, uint32_t w, uint32_t h)
@@ -110,7 +105,7 @@ static sy_result run_setting(setting *s, const uint8_t *px, uint32_t w, uint32_t
         s->enc_s += sy_time_now() - t0;
         if (r == SY_OK) r = sy_jpeg_decode_rgba8(jpeg, len, n, &dec, &dw, &dh, err);
         if (r == SY_OK) {
-            luma_8(dec, n, tmp);
+            sy_filter_luma_rgba8(dec, n, tmp);
             s->bytes += (double)len;
         }
         free(jpeg);
@@ -124,7 +119,7 @@ static sy_result run_setting(setting *s, const uint8_t *px, uint32_t w, uint32_t
         s->enc_s += sy_time_now() - t0;
         if (r == SY_OK) r = sy_web_video_decode(s->dec, pkt, len, &dec, &dw, &dh, err);
         if (r == SY_OK) {
-            luma_8(dec, n, tmp);
+            sy_filter_luma_rgba8(dec, n, tmp);
             s->bytes += (double)len, s->keys += key;
         }
     }

@@ -41,6 +41,12 @@ static void moments_pass(const float *g, uint32_t w, uint32_t h, bool vertical, 
         }
 }
 
+void sy_filter_luma_rgba8(const uint8_t *rgba, size_t n, float *out)
+{
+    for (size_t i = 0; i < n; ++i)
+        out[i] = (0.2126f * rgba[4 * i] + 0.7152f * rgba[4 * i + 1] + 0.0722f * rgba[4 * i + 2]) / 255.0f;
+}
+
 double sy_filter_ssim_gray(const float *a, const float *b, uint32_t w, uint32_t h)
 {
     const int R = SSIM_R;

@@ -35,6 +35,10 @@ sy_filter_status sy_filter_metrics_compute(const float *image, const float *refe
 /** SSIM alone on two single-channel images already in [0, 1] (dynamic range L = 1). */
 double sy_filter_ssim_gray(const float *a, const float *b, uint32_t width, uint32_t height);
 
+/** The Rec. 709 luma of n RGBA8 pixels (the display-encoded values / 255, alpha ignored) into out
+ * (n floats in [0, 1]): what sy_filter_ssim_gray compares of 8-bit images. */
+void sy_filter_luma_rgba8(const uint8_t *rgba, size_t n, float *out);
+
 #ifdef __cplusplus
 }
 #endif

@@ -117,6 +117,14 @@ async function canvasPng(page, selector, path) {
   await page.evaluate(() => { for (const e of document.body.querySelectorAll('*')) e.style.visibility = ''; });
 }
 
+// the warping page (warp, orbit) shows a full-size, exact frame answering every input sent so far
+function exactFrame(page) {
+  return page.waitForFunction(
+    ([w, h]) => window.syStats && window.sy && syStats.frames > 0 && syStats.width === w && syStats.height === h &&
+                syStats.answeredInput === syStats.lastInput && sy.stats().estimate_share === 0,
+    [width, height], { timeout: TIMEOUT });
+}
+
 // mean absolute difference (0..255, RGB) of two PNG files of the same size, computed in page p
 async function pngMad(p, fa, fb) {
   const a = readFileSync(fa).toString('base64'), b = readFileSync(fb).toString('base64');
@@ -255,11 +263,7 @@ try {
     const after = await page.evaluate(() => ({ ...syStats }));
     console.log(JSON.stringify({ before, after, consoleErrors }));
   } else if (mode === 'warp') {
-    // a full-size, exact frame answering every input sent so far
-    const settled = () => page.waitForFunction(
-      ([w, h]) => window.syStats && window.sy && syStats.frames > 0 && syStats.width === w && syStats.height === h &&
-                  syStats.answeredInput === syStats.lastInput && sy.stats().estimate_share === 0,
-      [width, height], { timeout: TIMEOUT });
+    const settled = () => exactFrame(page);
     const pct = (a, q) => { const s = [...a].sort((x, y) => x - y); return s.length ? s[Math.min(s.length - 1, Math.floor(q * s.length))] : null; };
     const summary = (a) => ({ n: a.length, p50: pct(a, 0.5), p95: pct(a, 0.95), max: a.length ? Math.max(...a) : null });
     await settled().catch(() => fail('no full-size frame within the timeout'));
@@ -377,10 +381,7 @@ try {
                                  frames_during_drag: st.frames - frames0, mid, quality, bad: st.bad, badFrames, consoleErrors,
                                  input_to_display_all: drag.map((v) => Math.round(v)) }));
   } else if (mode === 'orbit') {
-    const settled = () => page.waitForFunction(
-      ([w, h]) => window.syStats && window.sy && syStats.frames > 0 && syStats.width === w && syStats.height === h &&
-                  syStats.answeredInput === syStats.lastInput && sy.stats().estimate_share === 0,
-      [width, height], { timeout: TIMEOUT });
+    const settled = () => exactFrame(page);
     await settled().catch(() => fail('no full-size frame within the timeout'));
     const degS = Number(process.env.SY_ORBIT_DEG_S || 10), secs = Number(process.env.SY_ORBIT_S || 6);
     const everyMs = Number(process.env.SY_ORBIT_EVERY_MS || 250), held = process.env.SY_ORBIT_HOLD === '1';

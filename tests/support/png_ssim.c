@@ -12,13 +12,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* the luma of an RGBA8 image, 0..1 */
+/* the luma of an RGBA8 image, 0..1 (sy_filter_luma_rgba8); NULL when out of memory */
 static float *luma(const uint8_t *px, size_t n)
 {
     float *y = malloc(n * sizeof *y);
-    if (!y) return NULL;
-    for (size_t i = 0; i < n; ++i)
-        y[i] = (0.2126f * px[4 * i] + 0.7152f * px[4 * i + 1] + 0.0722f * px[4 * i + 2]) / 255.0f;
+    if (y) sy_filter_luma_rgba8(px, n, y);
     return y;
 }
 
