@@ -383,6 +383,21 @@ static bool json_bool(const cJSON *o, const char *key, bool *out)
     return !v || cJSON_IsBool(v);
 }
 
+/* A drag's or lead message's "lead": [DX, DY] within +-SY_WEB_LEAD_MAX (absent: [0, 0] where optional). */
+static bool json_lead(const cJSON *o, bool required, double out[2])
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, "lead");
+    out[0] = out[1] = 0;
+    if (!v) return !required;
+    if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 2) return false;
+    for (int k = 0; k < 2; ++k) {
+        const cJSON *e = cJSON_GetArrayItem(v, k);
+        if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) || fabs(e->valuedouble) > SY_WEB_LEAD_MAX) return false;
+        out[k] = e->valuedouble;
+    }
+    return true;
+}
+
 /* An optional request number "seq" (absent: 0). */
 static bool json_seq(const cJSON *o, uint32_t *out)
 {
@@ -520,12 +535,15 @@ sy_result sy_web_parse_input(const char *text, size_t len, sy_web_input *out, sy
         if (r == SY_OK) parse_codecs(cJSON_GetObjectItemCaseSensitive(m, "codecs"), out);
     } else if (!strcmp(type, "keyframe")) {
         out->type = SY_WEB_INPUT_KEYFRAME;
-    } else if (!strcmp(type, "drag")) {
-        out->type = SY_WEB_INPUT_DRAG;
-        if (!json_num(m, "dx", -1e5, 1e5, &out->a) || !json_num(m, "dy", -1e5, 1e5, &out->b))
+    } else if (!strcmp(type, "drag") || !strcmp(type, "lead")) {
+        bool drag = type[0] == 'd';
+        out->type = drag ? SY_WEB_INPUT_DRAG : SY_WEB_INPUT_LEAD;
+        if (drag && (!json_num(m, "dx", -1e5, 1e5, &out->a) || !json_num(m, "dy", -1e5, 1e5, &out->b)))
             r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "drag: dx and dy must be numbers within +-1e5");
         else if (cJSON_GetObjectItemCaseSensitive(m, "b") && (!json_num(m, "b", 0, 2, &btn) || btn != floor(btn)))
-            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "drag: b must be 0, 1 or 2");
+            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: b must be 0, 1 or 2", type);
+        else if (!json_lead(m, !drag, out->lead))
+            r = sy_error_set(err, SY_ERR_INVALID_ARGUMENT, "%s: lead must be [dx, dy], numbers within +-%g", type, SY_WEB_LEAD_MAX);
         out->button = (uint32_t)btn;
     } else if (!strcmp(type, "wheel")) {
         out->type = SY_WEB_INPUT_WHEEL;

@@ -145,8 +145,10 @@ typedef enum sy_web_input_type {
     SY_WEB_INPUT_ENVIRONMENT, /**< the environment by name (filter: "scene", "studio", "none"; judged by the server) */
     SY_WEB_INPUT_ANIM,     /**< {"t":"anim","clip":N}: the clip the scene clock plays (a: N, an index of the
                             *   hello's "clips", -1 every clip; the index's range is the server's check) */
-    SY_WEB_INPUT_VIEW      /**< {"t":"view","n":N[,"save":true]}: a saved view (sy_bookmarks.h): slot N
+    SY_WEB_INPUT_VIEW,     /**< {"t":"view","n":N[,"save":true]}: a saved view (sy_bookmarks.h): slot N
                             *   (1..SY_BOOKMARKS_MAX) recalled, or (on) the view now saved there */
+    SY_WEB_INPUT_LEAD      /**< {"t":"lead","lead":[DX,DY],"b":B}: the lead alone (lead, button; [0,0]: the
+                            *   page rests), the camera as it is (docs/WEB.md, "Frames rendered ahead") */
 } sy_web_input_type;
 
 /** Node ids a page may name: 1..SY_WEB_NODE_ID_MAX (sy_node.id); unknown ones are refused later. */
@@ -155,6 +157,8 @@ typedef enum sy_web_input_type {
 #define SY_WEB_TIME_MAX 1e9
 /** The clip indices a page may name ("anim": -1 = every clip; unknown ones are refused later). */
 #define SY_WEB_CLIP_MAX 65535
+/** The lead a page may ask for, pixels of drag each way (+-). */
+#define SY_WEB_LEAD_MAX 4096.0
 /** Exposure a page may set, in stops (+-). */
 #define SY_WEB_EXPOSURE_MAX 16.0
 /** The most codec names a size message may list ("codecs"); further ones are ignored. */
@@ -167,7 +171,10 @@ typedef struct sy_web_input {
     sy_web_input_type type;
     double a, b;     /**< size: w, h; drag: dx, dy; wheel: steps; pick: x, y in [0, 1) of the canvas; exposure: stops;
                       * time: seconds (finite, within +-SY_WEB_TIME_MAX) */
-    uint32_t button; /**< drag: 0 orbit, 1 or 2 pan */
+    uint32_t button; /**< drag, lead: 0 orbit, 1 or 2 pan */
+    double lead[2];  /**< drag, lead: "lead": [DX, DY], a drag of that many pixels more (same button) that
+                      * the frames answering it are rendered ahead by, the camera staying where the drags
+                      * put it; within +-SY_WEB_LEAD_MAX each (drag: absent = [0, 0]) */
     char key;        /**< key: '1'..'9', 'f', '[', ']', 'r' (lower case) */
     uint32_t version; /**< size: the frame format the page reads ("v", 0..1000; 0 = absent: a page
                        * older than frame format 3, refused with a status message) */

@@ -326,10 +326,14 @@ static sy_result publish_rendered(sy_web *w, render_state *rs, const sy_mediator
 }
 
 /* One frame through the frame-time governor (core/sy_governor.h): plans it for the display size,
- * renders what the plan says, reports its time. *again: plan again without waiting for input;
- * *wait_ms > 0: plan again after that long (the view is settling). */
-static sy_result render_frame(sy_web *w, render_state *rs, const sy_interactive_input *in, uint32_t bi, uint32_t dw,
-                              uint32_t dh, uint64_t gen, bool *again, double *wait_ms, sy_error *err)
+ * renders what the plan says, reports its time. ahead: the orbit the frame is rendered from (the
+ * pages' orbit, in->orbit, moved on by their lead: docs/WEB.md, "Frames rendered ahead"); the
+ * frame's header names in->orbit, its camera is ahead's, w->view stays in->orbit's (picks, saved
+ * views). *again: plan again without waiting for input; *wait_ms > 0: plan again after that long
+ * (the view is settling). */
+static sy_result render_frame(sy_web *w, render_state *rs, const sy_interactive_input *in, const sy_orbit *ahead,
+                              uint32_t bi, uint32_t dw, uint32_t dh, uint64_t gen, bool *again, double *wait_ms,
+                              sy_error *err)
 {
     *again = false, *wait_ms = 0;
     const sy_mediator_class *cls = sy_mediator_at(bi);
@@ -343,12 +347,13 @@ static sy_result render_frame(sy_web *w, render_state *rs, const sy_interactive_
     }
     if (r != SY_OK) return r;
     sy_governor_frame gf;
-    sy_interactive_view iv = {.orbit = &in->orbit, .viewports = &rs->vp, .viewport_count = 1, .backend = cls,
+    sy_interactive_view iv = {.orbit = ahead, .viewports = &rs->vp, .viewport_count = 1, .backend = cls,
                               .caps = sy_mediator_class_caps(cls, NULL), .width = pw, .height = ph,
                               .filter_version = in->filter_version, .changed = rs->changed};
     rs->changed = false;
     /* the view set on the viewport directly: the application's scene is not committed */
     sy_interactive_plan(rs->ia, &iv, sy_time_now() * 1e3, &gf, &w->view);
+    if (ahead != &in->orbit) sy_orbit_matrix(&in->orbit, &w->view); /* the pages' view, not the one ahead */
     if (gf.wait_ms > 0) { /* settling after a moving frame: the refining frame comes next */
         *wait_ms = gf.wait_ms;
         return SY_OK;
@@ -410,13 +415,13 @@ static void republish_with_pixels(sy_web *w, render_state *rs)
 }
 
 /* The live frame (the governor says its size) and what a failed back-end tells the pages. */
-static void render_live(sy_web *w, render_state *rs, const sy_interactive_input *in, uint32_t bi, uint32_t dw, uint32_t dh,
-                        uint64_t gen, bool *again, double *wait_until)
+static void render_live(sy_web *w, render_state *rs, const sy_interactive_input *in, const sy_orbit *ahead, uint32_t bi,
+                        uint32_t dw, uint32_t dh, uint64_t gen, bool *again, double *wait_until)
 {
     *again = false, *wait_until = 0;
     sy_error ferr = {0};
     double wait_ms = 0;
-    if (render_frame(w, rs, in, bi, dw, dh, gen, again, &wait_ms, &ferr) == SY_OK) {
+    if (render_frame(w, rs, in, ahead, bi, dw, dh, gen, again, &wait_ms, &ferr) == SY_OK) {
         if (wait_ms > 0) *wait_until = sy_time_now() * 1e3 + wait_ms;
     } else {
         /* a back-end that fails is reported to the pages; the others keep serving */
@@ -541,6 +546,11 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
         /* moving frames keep d.min_scale of the display while every viewer's page warps (it answers
          * inputs itself: detail counts for more than rate), else the governor's own floor */
         float floor_scale = w->plain_viewers ? 0.0f : w->d.min_scale;
+        /* frames rendered ahead by the last drag's lead (docs/WEB.md), while every viewer warps (a
+         * page that does not would show a view its hand has not reached) */
+        float lead[2] = {w->lead[0], w->lead[1]};
+        int lead_button = w->lead_button >= 1 ? 1 : 0;
+        bool ahead = !w->plain_viewers && (lead[0] != 0.0f || lead[1] != 0.0f);
         bool need_pixels = w->need_pixels;
         w->need_pixels = false;
         float fov_req = w->fov_req; /* a recalled view's field of view (sy_web_views.c) */
@@ -567,7 +577,10 @@ sy_result sy_web_run(sy_web *w, volatile int *stop, sy_error *err)
         }
         bool due = again || (wait_until > 0 && sy_time_now() * 1e3 >= wait_until);
         sy_interactive_set_min_scale(rs.ia, floor_scale);
-        if (clients && (moved || due)) render_live(w, &rs, &in, bi, dw, dh, gen, &again, &wait_until);
+        sy_interactive_input led = in;
+        if (ahead) sy_interactive_drag(&led, lead_button, lead[0], lead[1]);
+        if (clients && (moved || due))
+            render_live(w, &rs, &in, ahead ? &led.orbit : &in.orbit, bi, dw, dh, gen, &again, &wait_until);
         /* after render_live, which may have rendered nothing (a view at rest) */
         if (need_pixels) republish_with_pixels(w, &rs);
         /* then one still: stills wait behind the live view */

@@ -115,6 +115,7 @@ static sy_result pick(const sy_web_scene_ctx *sc, double fx, double fy, sy_pick_
     const sy_mediator_class *cls = sy_mediator_at(sc->backend);
     if (cls && (cls->caps & need) == need) {
         *by = cls->name;
+        sy_viewport_set_view(sc->vp, &w->view); /* the pages' view: the last frame may be rendered ahead of it */
         return sy_viewport_pick(sc->vp, w->d.scene, sc->pool, x, y, p, err);
     }
     cls = sy_mediator_with_caps(need);

@@ -319,6 +319,11 @@ static void ws_message(sy_web *w, web_conn *c, const char *text, size_t len)
         w->display_w = (uint32_t)in.a, w->display_h = (uint32_t)in.b;
         break;
     case SY_WEB_INPUT_DRAG: sy_interactive_drag(&w->in, in.button >= 1 ? 1 : 0, (float)in.a, (float)in.b); break;
+    case SY_WEB_INPUT_LEAD: /* the lead alone (the page rests: [0, 0]): a new frame only when it changed */
+        input = false;
+        if (w->lead[0] != (float)in.lead[0] || w->lead[1] != (float)in.lead[1] || w->lead_button != in.button)
+            w->view_version++;
+        break;
     case SY_WEB_INPUT_WHEEL: sy_interactive_wheel(&w->in, (float)in.a); break;
     case SY_WEB_INPUT_KEYFRAME: break; /* handled above */
     case SY_WEB_INPUT_KEY:
@@ -331,6 +336,10 @@ static void ws_message(sy_web *w, web_conn *c, const char *text, size_t len)
         }
         break;
     }
+    if (in.type == SY_WEB_INPUT_DRAG || in.type == SY_WEB_INPUT_LEAD) /* what frames lead by from now on */
+        w->lead[0] = (float)in.lead[0], w->lead[1] = (float)in.lead[1], w->lead_button = in.button;
+    else if (input) /* the camera moved otherwise (wheel, keys, a saved view): no lead until the next drag */
+        w->lead[0] = w->lead[1] = 0.0f;
     if (input) {
         w->view_version++;
         w->input_gen++;

@@ -32,7 +32,9 @@
 //     and OUTDIR/true_K.png, K from 0, compared by SY_PNG_SSIM (tests/support/png_ssim.c: SSIM of
 //     luma). Prints {captures: [{k, ms, estimate, unfilled, yaw, yaw_true, refs, turned_deg, ssim}],
 //     ssim_median, ssim_p10, ssim_min over the estimates, unfilled_max over all captures,
-//     yaw_diff_max (estimate's view against its true frame's), ...}.
+//     yaw_diff_max (estimate's view against its true frame's), frame_ms_p50 (the last 60 display
+//     frames), ahead (sy.stats().ahead: frames rendered ahead, the last lead), ...}. URL?ahead=0:
+//     the page sends no lead (docs/WEB.md, "Frames rendered ahead"), the comparison.
 //   node browser.mjs tools URL OUTDIR WIDTH HEIGHT
 //     The page's tools (sy web, a canvas wide enough for the panel): finds a covered pixel near
 //     the centre (the server's still of the view), clicks it (pick + select; the properties show
@@ -451,9 +453,10 @@ try {
     const s = est.map((c) => c.ssim).sort((a, b) => a - b), q = (p) => s[Math.min(s.length - 1, Math.floor(p * s.length))];
     const angle = (a, b) => { const d = Math.abs(a - b) % (2 * Math.PI); return Math.min(d, 2 * Math.PI - d); };
     const st = await page.evaluate(() => sy.stats());
-    console.log(JSON.stringify({ held, deg_s: degS, secs, estimates: est.length, ssim_median: q(0.5), ssim_p10: q(0.1), ssim_min: s[0],
+    const fm = st.frame_ms.slice(-60).sort((a, b) => a - b);
+    console.log(JSON.stringify({ held, deg_s: degS, secs, estimates: est.length, frame_ms_p50: fm[fm.length >> 1], ssim_median: q(0.5), ssim_p10: q(0.1), ssim_min: s[0],
                                  unfilled_max: Math.max(...out.map((c) => c.unfilled)), yaw_diff_max: Math.max(...est.map((c) => angle(c.yaw, c.yaw_true))),
-                                 bad: st.bad, server_fps: st.server_fps, stride: st.stride, warp_scale: st.warp_scale, consoleErrors, captures: out }));
+                                 bad: st.bad, server_fps: st.server_fps, stride: st.stride, warp_scale: st.warp_scale, ahead: st.ahead, consoleErrors, captures: out }));
   } else if (mode === 'converge') {
     // a still view of a progressive back-end: the canvas early (the first full-size frames) and
     // late (16 times the samples, at least 64): noise, the mean absolute difference of each pixel

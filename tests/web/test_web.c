@@ -24,6 +24,9 @@
  *   web_warpfloor moving frames keep half the display's side while every viewer's page warps ("warp":
  *                 true in its size message), the governor's eighth while one does not (a budget every
  *                 frame overruns puts the governor at its floor); a "warp" that is no boolean is refused
+ *   web_ahead     frames rendered ahead: a drag's "lead" renders its frame that much further on (the
+ *                 header's orbit the drag's, the camera led on); a lead of [0, 0] brings the exact view
+ *                 back, a lead message alone leads, a wheel ends the lead; not while a viewer does not warp
  *   web_progressive  the path tracer refines while the view rests and restarts when it moves;
  *                 the refinements leave the depth channel out (SAME_DEPTH) and it decodes as before
  *   web_token     listening on 0.0.0.0: without the token 401 with the page saying it is missing,
@@ -108,7 +111,7 @@ int main(int argc, char **argv)
         int (*run)(void);
     } alone[] = {{"messages", test_messages},   {"timeline", test_timeline},       {"frame", test_frame},
                  {"encodecost", test_encode_cost}, {"clientfiles", test_client_files}, {"token", test_token},
-                 {"progressive", test_progressive}, {"views", test_views}, {"warpfloor", test_warp_floor}};
+                 {"progressive", test_progressive}, {"views", test_views}, {"warpfloor", test_warp_floor}, {"ahead", test_ahead}};
     for (size_t i = 0; i < sizeof alone / sizeof alone[0]; ++i)
         if (!strcmp(which, alone[i].name)) {
             int f = alone[i].run();

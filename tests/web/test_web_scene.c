@@ -45,6 +45,20 @@ int test_messages(void)
     CHECK(parse_ok("{\"t\":\"pick\",\"x\":0.5,\"y\":0.5,\"select\":true}", &in) && !sy_web_input_changes_scene(&in));
     CHECK(parse_ok("{\"t\":\"tree\"}", &in) && !sy_web_input_changes_scene(&in));
     CHECK(parse_ok("{\"t\":\"drag\",\"dx\":1,\"dy\":2}", &in) && !sy_web_input_changes_scene(&in));
+    /* frames rendered ahead: a drag's optional lead, the lead alone (the camera, allowed read-only) */
+    CHECK(in.lead[0] == 0 && in.lead[1] == 0);
+    CHECK(parse_ok("{\"t\":\"drag\",\"dx\":1,\"dy\":2,\"b\":2,\"lead\":[7.5,-3]}", &in) && in.button == 2 &&
+          in.lead[0] == 7.5 && in.lead[1] == -3);
+    CHECK(parse_ok("{\"t\":\"lead\",\"lead\":[0,0]}", &in) && in.type == SY_WEB_INPUT_LEAD && in.button == 0 &&
+          !sy_web_input_changes_scene(&in));
+    CHECK(parse_ok("{\"t\":\"lead\",\"lead\":[-4096,12],\"b\":1}", &in) && in.lead[0] == -4096 && in.button == 1);
+    const char *bad_lead[] = {"{\"t\":\"lead\"}", "{\"t\":\"lead\",\"lead\":[1]}", "{\"t\":\"lead\",\"lead\":[1,2,3]}",
+                              "{\"t\":\"lead\",\"lead\":[4097,0]}", "{\"t\":\"lead\",\"lead\":[1,null]}",
+                              "{\"t\":\"lead\",\"lead\":{\"dx\":1}}", "{\"t\":\"lead\",\"lead\":[0,0],\"b\":3}",
+                              "{\"t\":\"drag\",\"dx\":1,\"dy\":0,\"lead\":\"ahead\"}",
+                              "{\"t\":\"drag\",\"dx\":1,\"dy\":0,\"lead\":[1e400,0]}"};
+    for (size_t i = 0; i < sizeof bad_lead / sizeof bad_lead[0]; ++i)
+        CHECK_MSG(sy_web_parse_input(bad_lead[i], strlen(bad_lead[i]), &in, &err) != SY_OK, "accepted %s", bad_lead[i]);
     /* the timeline: a view change (a read-only page may move the clock); the range is the server's */
     CHECK(parse_ok("{\"t\":\"time\",\"s\":1.25}", &in) && in.type == SY_WEB_INPUT_TIME && in.a == 1.25 &&
           !sy_web_input_changes_scene(&in));

@@ -187,6 +187,91 @@ int test_warp_floor(void)
     return web_stop(&s);
 }
 
+/* the largest difference between a frame's camera and the orbit matrix of o */
+static float camera_off(const sy_web_frame_info *fi, const sy_orbit *o)
+{
+    sy_mat4 m;
+    sy_orbit_matrix(o, &m);
+    float d = 0;
+    for (int i = 0; i < 16; ++i) d = fmaxf(d, fabsf(m.m[i] - fi->view.camera_to_world.m[i]));
+    return d;
+}
+
+/* frames from c until one whose camera is o's (within 1e-5): 0, else 1 after 40 frames */
+static int frame_from(sy_web_client *c, const sy_orbit *o, sy_web_frame_info *fi)
+{
+    for (int k = 0; k < 40; ++k) {
+        if (web_next_frame(c, fi, NULL, NULL)) return 1;
+        if (camera_off(fi, o) < 1e-5f) return 0;
+    }
+    return 1;
+}
+
+/* web_ahead: a drag's lead renders its frame further along (the header's orbit is where the drags
+ * put the camera, the frame's camera the orbit moved on by the lead); {"t":"lead","lead":[0,0]}
+ * brings the exact view back; a wheel ends the lead; with a viewer whose page does not warp the
+ * lead is not used (docs/WEB.md, "Frames rendered ahead") */
+int test_ahead(void)
+{
+    sy_error err = {0};
+    server s;
+    if (web_start(&s, "127.0.0.1:0", "whitted", &err)) return 1;
+    sy_web_client *c = NULL, *d = NULL;
+    sy_web_client_opts o = {.host = "127.0.0.1", .port = sy_web_port(s.web), .path = "/ws"};
+    CHECK_OK(sy_web_client_connect(&o, 10000, &c, &err), err);
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"size\",\"w\":64,\"h\":40,\"v\":3,\"warp\":true}", &err), err);
+    sy_web_frame_info fi;
+    do {
+        CHECK_OK(sy_web_client_next_frame(c, 60000, &fi, NULL, NULL, &err), err);
+    } while (fi.width != 64);
+    sy_orbit start = fi.orbit;
+    CHECK_MSG(camera_off(&fi, &start) < 1e-5f, "a frame before any lead: its camera %g off its orbit's", camera_off(&fi, &start));
+    /* a drag of 10 pixels with a lead of 30: the frame's orbit 10 on, its camera 40 on */
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"drag\",\"dx\":10,\"dy\":0,\"lead\":[30,0],\"id\":1}", &err), err);
+    sy_orbit moved = start, ahead;
+    sy_orbit_rotate(&moved, 10, 0);
+    ahead = moved;
+    sy_orbit_rotate(&ahead, 30, 0);
+    do {
+        if (web_next_frame(c, &fi, NULL, NULL)) return 1;
+    } while (fi.input_id < 1);
+    printf("ahead: the frame answering the drag: orbit yaw %.5f (the drag's %.5f), camera %.2g off the orbit "
+           "led 30 pixels on, %.2g off the drag's\n", fi.orbit.yaw, moved.yaw, camera_off(&fi, &ahead), camera_off(&fi, &moved));
+    CHECK_MSG(fi.orbit.yaw == moved.yaw && fi.orbit.pitch == moved.pitch, "the header's orbit (yaw %g) is not the drag's (%g)",
+              fi.orbit.yaw, moved.yaw);
+    CHECK_MSG(camera_off(&fi, &ahead) < 1e-5f, "the frame's camera is %g off the orbit led 30 pixels on", camera_off(&fi, &ahead));
+    CHECK(camera_off(&fi, &moved) > 0.05f);
+    /* the page rests: the exact view again, answering the same input */
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"lead\",\"lead\":[0,0]}", &err), err);
+    CHECK_MSG(!frame_from(c, &moved, &fi), "no frame of the exact view after the lead ended");
+    CHECK(fi.input_id == 1 && fi.orbit.yaw == moved.yaw);
+    /* a lead alone moves the camera on, the orbit stays; a malformed one is refused (nothing changes) */
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"lead\",\"lead\":[20,0],\"b\":0}", &err), err);
+    ahead = moved;
+    sy_orbit_rotate(&ahead, 20, 0);
+    CHECK_MSG(!frame_from(c, &ahead, &fi), "no frame led by a lead message");
+    CHECK(fi.orbit.yaw == moved.yaw);
+    /* a wheel: the camera moved otherwise, no lead until the next drag */
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"wheel\",\"steps\":1,\"id\":2}", &err), err);
+    sy_orbit zoomed = moved;
+    sy_orbit_zoom(&zoomed, 1);
+    CHECK_MSG(!frame_from(c, &zoomed, &fi), "the lead outlived a wheel");
+    /* a second viewer that does not warp: the lead is not used */
+    CHECK_OK(sy_web_client_connect(&o, 10000, &d, &err), err);
+    CHECK_OK(sy_web_client_send(d, "{\"t\":\"size\",\"w\":64,\"h\":40,\"v\":3}", &err), err);
+    CHECK_OK(sy_web_client_next_frame(d, 60000, &fi, NULL, NULL, &err), err); /* sized: counted as a plain viewer */
+    CHECK_OK(sy_web_client_send(c, "{\"t\":\"drag\",\"dx\":-10,\"dy\":0,\"lead\":[-30,0],\"id\":3}", &err), err);
+    sy_orbit back = zoomed;
+    sy_orbit_rotate(&back, -10, 0);
+    do {
+        if (web_next_frame(c, &fi, NULL, NULL)) return 1;
+    } while (fi.input_id < 3);
+    CHECK_MSG(camera_off(&fi, &back) < 1e-5f, "with a viewer that does not warp: the camera %g off the drag's", camera_off(&fi, &back));
+    sy_web_client_close(d);
+    sy_web_client_close(c);
+    return web_stop(&s);
+}
+
 /* the path tracer refines while the view rests (samples grow frame after frame) and restarts
  * when it moves (the frame answering a drag has fewer samples than the one before) */
 int test_progressive(void)

@@ -111,6 +111,7 @@ int test_frame(void);
 int test_video_stream(uint16_t port);
 int test_encode_cost(void);
 int test_warp_floor(void);
+int test_ahead(void);
 /* The server's connections in this process (TCP sockets whose local port is port and that have a
  * peer): how many there are into *n, and how many of them have TCP_NODELAY into *nodelay. */
 void web_server_sockets(uint16_t port, int *n, int *nodelay);

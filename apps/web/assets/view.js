@@ -10,6 +10,7 @@
   const badge = document.getElementById("sy-estimate");
   const params = new URLSearchParams(location.search);
   const warpOn = params.get("warp") !== "0", showHoles = params.get("holes") === "1";
+  const aheadOn = params.get("ahead") !== "0"; // ?ahead=0: frames of the view the inputs reached (the comparison)
   const FORMAT = 3, HEADER = 192, MAGIC = 0x33465953, SAME_DEPTH = 4;
   // Test hook (browser tests): frames received, the newest input id sent and the one the last
   // frame answers, the frame's size, back-end, samples and render time.
@@ -22,7 +23,7 @@
   const bad = { magic: 0, version: 0, size: 0, large: 0, order: 0, camera: 0, depth: 0, jpeg: 0, video: 0 };
   const asked = { w: 0, h: 0 }; // the largest frame size asked for on this connection
   const video = window.syVideo || null; // video.js: the video stream's decoder (docs/WEB.md)
-  const hist = { input: [], frame: [], bytes: [], arrivals: [], adopt: [], depth: [] };
+  const hist = { input: [], frame: [], bytes: [], arrivals: [], adopt: [], depth: [], latency: [] };
   const depthCount = { own: 0, same: 0, none: 0, mesh_kept: 0 }; // frames shown by where their depth came from
   function keep(a, v, n) { a.push(v); if (a.length > n) a.shift(); }
 
@@ -344,20 +345,26 @@
       const warpable = f.warpable && !!depth && f.w > 1 && f.h > 1;
       // two views: a frame of the newest one's view (its refinement) replaces it, and keeps its
       // mesh when the depth is the same (a progressive back-end's samples: SAME_DEPTH)
-      const same = refs.length && JSON.stringify(refs[0].orbit) === JSON.stringify(f.orbit);
+      const same = refs.length && JSON.stringify(refs[0].orbit) === JSON.stringify(f.orbit) &&
+                   refs[0].c2w.every((x, i) => x === f.c2w[i]);
       const keepMesh = same && warpable && refs[0].mesh && refs[0].src === src && refs[0].stride === stride;
       if (keepMesh) { refs[0].meshKept = true; depthCount.mesh_kept++; }
       const r = { color: texture(f.w, f.h, bmp),
                   mesh: keepMesh ? refs[0].mesh : warpable ? buildMesh(depth, f.w, f.h, f.win, stride) : null,
                   src: src, stride: stride,
-                  w: f.w, h: f.h, c2w: f.c2w, win: f.win, orbit: f.orbit, seq: f.seq, answered: f.answered, warpable: warpable };
+                  w: f.w, h: f.h, c2w: f.c2w, win: f.win, orbit: f.orbit, seq: f.seq, answered: f.answered, warpable: warpable,
+                  ahead: renderedAhead(f) };
+      if (r.ahead) aheadFrames++;
       if (same) freeRef(refs.shift());
       refs.unshift(r);
       while (refs.length > 2) freeRef(refs.pop());
     } else {
       g2.drawImage(bmp, 0, 0, canvas.width, canvas.height);
     }
-    // the inputs this frame includes are no longer predicted on top of it
+    // the inputs this frame includes are no longer predicted on top of it; the newest one's time
+    // to this frame is the latency the lead covers
+    const now = performance.now();
+    for (const s of sent) if (s.id === f.answered) keep(hist.latency, now - s.t, 16);
     while (sent.length && sent[0].id <= f.answered) sent.shift();
     newFrame = true;
   }
@@ -415,7 +422,7 @@
   function draw() {
     const cw = canvas.width, ch = canvas.height;
     const r0 = refs[0];
-    if (!warpOn || !sent.length || !r0.warpable) { // the newest frame as it is
+    if (!warpOn || (!sent.length && !r0.ahead) || !r0.warpable) { // the newest frame as it is
       gl.bindFramebuffer(gl.FRAMEBUFFER, null);
       gl.viewport(0, 0, cw, ch);
       gl.useProgram(blitProg.p);
@@ -504,6 +511,10 @@
       drawnServer = drawnInput = stats.answeredInput;
     }
     lastWarped = estimate === 1 && (newFrame || moved);
+    if (leadSent && now - lastDrag > LEAD_REST_MS) { // the hand rests: frames of the view it reached
+      leadSent = false;
+      send({ t: "lead", lead: [0, 0], b: 0 });
+    }
     newFrame = moved = false;
     badge.style.display = estimate ? "block" : "none";
     requestAnimationFrame(frame);
@@ -564,7 +575,8 @@
                depth: Object.assign({ bytes_per_frame: mean(hist.depth) }, depthCount),
                video: video ? video.stats() : null,
                shown_input: shownInput, last_input: inputId, frames: stats.frames,
-               display_frames: frameCount, inputs_displayed: inputCount, inputs_by_estimate: warpAnswered }; // counts: slice the arrays' ends
+               display_frames: frameCount, inputs_displayed: inputCount, inputs_by_estimate: warpAnswered, // counts: slice the arrays' ends
+               ahead: { on: aheadOn && warpOn && !!gl, lead_ms: leadMs, latency_ms: hist.latency.slice(), frames: aheadFrames } };
     },
     // tests: keep the references (frames arriving are dropped); released, the page asks for a frame
     hold: function (on) { hold = !!on; if (!hold) sendSize(); },
@@ -602,9 +614,51 @@
   function send(o) {
     if (ws && ws.readyState === 1) ws.send(JSON.stringify(o));
   }
+  // ---- frames rendered ahead (docs/WEB.md, "Frames rendered ahead") ----
+  // A warped frame is as good as its reference is near the view: while the hand moves steadily, each
+  // drag asks the server to render its frame further along by a lead, the drag the hand adds in the
+  // time until that frame shows plus half the time it stays the newest (the page's own measures:
+  // the median input-to-frame latency, the median interval between frames). The velocity: drag
+  // pixels over the last LEAD_WINDOW_MS (3 inputs at least, all with one button; a jump, such as a
+  // view recalled, is no motion). The frame's header keeps the orbit the inputs reached and its camera
+  // the one ahead: the page warps it to the local orbit as any reference. The hand rests
+  // (LEAD_REST_MS without a drag): lead [0, 0], and the server renders the exact view again.
+  const LEAD_WINDOW_MS = 400, LEAD_REST_MS = 250, LEAD_MAX_MS = 800, LEAD_MAX_PX = 64;
+  const drags = []; // {t, dx, dy, b}: recent drag inputs
+  let leadSent = false, lastDrag = 0, leadMs = 0, aheadFrames = 0;
+  function median(a) { const s = a.slice().sort((x, y) => x - y); return s.length ? s[s.length >> 1] : 0; }
+  function leadFor(m, t) {
+    keep(drags, { t: t, dx: m.dx, dy: m.dy, b: m.b || 0 }, 64);
+    lastDrag = t;
+    if (!aheadOn || !warpOn || !gl || hist.latency.length < 2) return null;
+    const win = drags.filter((d) => t - d.t <= LEAD_WINDOW_MS);
+    if (win.length < 3 || win.some((d) => d.b !== (m.b || 0))) return null;
+    const span = win[win.length - 1].t - win[0].t;
+    if (span < 30) return null;
+    let sx = 0, sy = 0;
+    for (let i = 1; i < win.length; i++) { sx += win[i].dx; sy += win[i].dy; } // the first's drag came before win[0].t
+    const gaps = [];
+    for (let i = Math.max(1, hist.arrivals.length - 9); i < hist.arrivals.length; i++) gaps.push(hist.arrivals[i] - hist.arrivals[i - 1]);
+    leadMs = Math.min(LEAD_MAX_MS, median(hist.latency) + median(gaps) / 2);
+    let lx = sx / span * leadMs, ly = sy / span * leadMs;
+    const len = Math.hypot(lx, ly);
+    if (len > LEAD_MAX_PX) { lx *= LEAD_MAX_PX / len; ly *= LEAD_MAX_PX / len; }
+    return len >= 0.05 ? [Math.round(lx * 100) / 100, Math.round(ly * 100) / 100] : null;
+  }
+  // a frame rendered ahead: its camera is not its orbit's (orbitMatrix: the server's maths in float)
+  function renderedAhead(f) {
+    const m = orbitMatrix(f.orbit);
+    for (let i = 0; i < 16; i++) if (Math.abs(m[i] - f.c2w[i]) > 1e-4 * (i >= 12 ? Math.max(1, f.orbit.dist) : 1)) return true;
+    return false;
+  }
   function input(o, e) { // e: the event (its timeStamp: when it happened, before any wait for the page)
-    o.id = ++inputId; stats.lastInput = inputId; send(o);
     const t = e && e.timeStamp > 0 && e.timeStamp <= performance.now() ? e.timeStamp : performance.now();
+    if (o.t === "drag") {
+      const lead = leadFor(o, t);
+      if (lead) o.lead = lead; // (a drag without one: [0, 0])
+      leadSent = !!lead;
+    }
+    o.id = ++inputId; stats.lastInput = inputId; send(o);
     const cam = o.t === "drag" || o.t === "wheel";
     waiting.push({ id: o.id, t: t, cam: cam });
     if (cam) { sent.push({ id: o.id, m: o, t: t }); moved = true; }
