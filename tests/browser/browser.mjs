@@ -292,7 +292,8 @@ try {
                                    by_estimate: (st.inputs_by_estimate - before.inputs_by_estimate) / Math.max(1, drag.length),
                                    server_fps: st.server_fps, bytes_per_frame: Math.round(st.bytes_per_frame), depth: st.depth,
                                    video: st.video && { codec: st.video.codec, bytes_per_frame: Math.round(st.video.bytes_per_frame) },
-                                   frames_during_drag: st.frames - frames0, bad: st.bad, stride: st.stride, warp_scale: st.warp_scale }));
+                                   frames_during_drag: st.frames - frames0, bad: st.bad, stride: st.stride, warp_scale: st.warp_scale,
+                                   adopt_ms: summary(st.adopt_ms.slice(-Math.min(st.adopt_ms.length, st.frames - frames0))) }));
       await browser.close();
       process.exit(0);
     }

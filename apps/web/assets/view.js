@@ -64,6 +64,7 @@
   const g2 = gl ? null : canvas.getContext("2d");
   const refs = []; // newest first, at most 2: {color, depth, w, h, c2w, win, orbit, seq, answered, warpable}
   let vao = null, prog = null, fillProg = null, blitProg = null, fbo = null, fboColor = null, fboDepth = null, fboW = 0, fboH = 0;
+  let fillFbo = null, fillTex = null; // the hole fill at the warp's resolution when that is below the canvas'
   function compile(vs, fs) {
     const p = gl.createProgram();
     for (const [type, src] of [[gl.VERTEX_SHADER, vs], [gl.FRAGMENT_SHADER, fs]]) {
@@ -133,16 +134,21 @@
         // uMark (sy.capture): alpha 0 where no ring found a covered pixel (the fill left a hole)
         o = vec4(uShowHoles == 1 ? mix(f, vec3(1.0, 0.0, 1.0), 0.5) : f, uMark == 1 && n == 0.0 ? 0.0 : 1.0);
       }`);
-    // the exact frame: scaled to the canvas
+    // the exact frame (rows top-down): scaled to the canvas; uCopy: a texture of ours (bottom-up,
+    // its alpha kept: the hole fill's marks) scaled to the target
     blitProg = compile(FULL, `
-      uniform sampler2D uColor; uniform vec2 uCanvas; out vec4 o;
-      void main() { vec2 uv = gl_FragCoord.xy / uCanvas; o = vec4(texture(uColor, vec2(uv.x, 1.0 - uv.y)).rgb, 1.0); }`);
+      uniform sampler2D uColor; uniform vec2 uCanvas; uniform int uCopy; out vec4 o;
+      void main() {
+        vec2 uv = gl_FragCoord.xy / uCanvas;
+        o = uCopy == 1 ? texture(uColor, uv) : vec4(texture(uColor, vec2(uv.x, 1.0 - uv.y)).rgb, 1.0);
+      }`);
     vao = gl.createVertexArray();
     gl.bindVertexArray(vao);
   }
   function ensureFbo(w, h) {
     if (fbo && fboW === w && fboH === h) return;
     if (fbo) { gl.deleteFramebuffer(fbo); gl.deleteTexture(fboColor); gl.deleteRenderbuffer(fboDepth); }
+    if (fillFbo) { gl.deleteFramebuffer(fillFbo); gl.deleteTexture(fillTex); fillFbo = fillTex = null; }
     fbo = gl.createFramebuffer(); fboColor = gl.createTexture(); fboDepth = gl.createRenderbuffer();
     gl.bindTexture(gl.TEXTURE_2D, fboColor);
     gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA8, w, h);
@@ -157,6 +163,18 @@
     gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.RENDERBUFFER, fboDepth);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
     fboW = w; fboH = h;
+    if (w !== canvas.width || h !== canvas.height) { // the fill at this size, then scaled (fill())
+      fillFbo = gl.createFramebuffer(); fillTex = gl.createTexture();
+      gl.bindTexture(gl.TEXTURE_2D, fillTex);
+      gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA8, w, h);
+      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.LINEAR);
+      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.LINEAR);
+      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_S, gl.CLAMP_TO_EDGE);
+      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_T, gl.CLAMP_TO_EDGE);
+      gl.bindFramebuffer(gl.FRAMEBUFFER, fillFbo);
+      gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, fillTex, 0);
+      gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    }
   }
   function texture(w, h, bmp) {
     const t = gl.createTexture();
@@ -427,7 +445,7 @@
       gl.viewport(0, 0, cw, ch);
       gl.useProgram(blitProg.p);
       gl.activeTexture(gl.TEXTURE0); gl.bindTexture(gl.TEXTURE_2D, r0.color);
-      gl.uniform1i(blitProg.u.uColor, 0); gl.uniform2f(blitProg.u.uCanvas, cw, ch);
+      gl.uniform1i(blitProg.u.uColor, 0); gl.uniform2f(blitProg.u.uCanvas, cw, ch); gl.uniform1i(blitProg.u.uCopy, 0);
       gl.drawArrays(gl.TRIANGLES, 0, 3);
       estimate = 0;
       return r0.answered;
@@ -460,16 +478,27 @@
     return inputId; // every input sent so far is in the local orbit
   }
   // the hole fill: the warp (fboColor) scaled to the canvas into target (null: the canvas); mark:
-  // alpha 0 where it found nothing to fill with (sy.capture)
+  // alpha 0 where it found nothing to fill with (sy.capture). A warp below the canvas' resolution
+  // is filled at its own (fillFbo) and then scaled, bilinear: the fill's cost follows the level (at
+  // the canvas' resolution it was most of a coarse level's display frame in SwiftShader)
   function fill(target, mark) {
-    gl.bindFramebuffer(gl.FRAMEBUFFER, target);
-    gl.viewport(0, 0, canvas.width, canvas.height);
+    const cw = canvas.width, ch = canvas.height, direct = !fillFbo || (fboW === cw && fboH === ch);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, direct ? target : fillFbo);
+    gl.viewport(0, 0, direct ? cw : fboW, direct ? ch : fboH);
     gl.useProgram(fillProg.p);
-    gl.uniform1f(fillProg.u.uScale, fboW / canvas.width);
+    gl.uniform1f(fillProg.u.uScale, direct ? fboW / cw : 1);
     gl.activeTexture(gl.TEXTURE0); gl.bindTexture(gl.TEXTURE_2D, fboColor);
     gl.uniform1i(fillProg.u.uWarp, 0); gl.uniform1i(fillProg.u.uShowHoles, showHoles ? 1 : 0);
     gl.uniform1i(fillProg.u.uMark, mark ? 1 : 0);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
+    if (!direct) {
+      gl.bindFramebuffer(gl.FRAMEBUFFER, target);
+      gl.viewport(0, 0, cw, ch);
+      gl.useProgram(blitProg.p);
+      gl.bindTexture(gl.TEXTURE_2D, fillTex);
+      gl.uniform1i(blitProg.u.uColor, 0); gl.uniform2f(blitProg.u.uCanvas, cw, ch); gl.uniform1i(blitProg.u.uCopy, 1);
+      gl.drawArrays(gl.TRIANGLES, 0, 3);
+    }
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
   }
   // the warp adapts to what the display frames cost: a level is the mesh density (a vertex every
