@@ -145,44 +145,45 @@
     vao = gl.createVertexArray();
     gl.bindVertexArray(vao);
   }
-  function ensureFbo(w, h) {
-    if (fbo && fboW === w && fboH === h) return;
-    if (fbo) { gl.deleteFramebuffer(fbo); gl.deleteTexture(fboColor); gl.deleteRenderbuffer(fboDepth); }
-    if (fillFbo) { gl.deleteFramebuffer(fillFbo); gl.deleteTexture(fillTex); fillFbo = fillTex = null; }
-    fbo = gl.createFramebuffer(); fboColor = gl.createTexture(); fboDepth = gl.createRenderbuffer();
-    gl.bindTexture(gl.TEXTURE_2D, fboColor);
-    gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA8, w, h);
+  // the bound TEXTURE_2D's sampling: bilinear, clamped at its edges
+  function linearClamp() {
     gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.LINEAR);
     gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.LINEAR);
     gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_S, gl.CLAMP_TO_EDGE);
     gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_T, gl.CLAMP_TO_EDGE);
+  }
+  // a new framebuffer drawing into a new RGBA8 texture of w x h (linearClamp): {fb, tex}
+  function colorTarget(w, h) {
+    const fb = gl.createFramebuffer(), tex = gl.createTexture();
+    gl.bindTexture(gl.TEXTURE_2D, tex);
+    gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA8, w, h);
+    linearClamp();
+    gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, tex, 0);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    return { fb: fb, tex: tex };
+  }
+  function ensureFbo(w, h) {
+    if (fbo && fboW === w && fboH === h) return;
+    if (fbo) { gl.deleteFramebuffer(fbo); gl.deleteTexture(fboColor); gl.deleteRenderbuffer(fboDepth); }
+    if (fillFbo) { gl.deleteFramebuffer(fillFbo); gl.deleteTexture(fillTex); fillFbo = fillTex = null; }
+    const t = colorTarget(w, h);
+    fbo = t.fb; fboColor = t.tex; fboDepth = gl.createRenderbuffer();
     gl.bindRenderbuffer(gl.RENDERBUFFER, fboDepth);
     gl.renderbufferStorage(gl.RENDERBUFFER, gl.DEPTH_COMPONENT24, w, h);
     gl.bindFramebuffer(gl.FRAMEBUFFER, fbo);
-    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, fboColor, 0);
     gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.RENDERBUFFER, fboDepth);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
     fboW = w; fboH = h;
     if (w !== canvas.width || h !== canvas.height) { // the fill at this size, then scaled (fill())
-      fillFbo = gl.createFramebuffer(); fillTex = gl.createTexture();
-      gl.bindTexture(gl.TEXTURE_2D, fillTex);
-      gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA8, w, h);
-      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.LINEAR);
-      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.LINEAR);
-      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_S, gl.CLAMP_TO_EDGE);
-      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_T, gl.CLAMP_TO_EDGE);
-      gl.bindFramebuffer(gl.FRAMEBUFFER, fillFbo);
-      gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, fillTex, 0);
-      gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+      const f = colorTarget(w, h);
+      fillFbo = f.fb; fillTex = f.tex;
     }
   }
   function texture(w, h, bmp) {
     const t = gl.createTexture();
     gl.bindTexture(gl.TEXTURE_2D, t);
-    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.LINEAR);
-    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.LINEAR);
-    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_S, gl.CLAMP_TO_EDGE);
-    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_T, gl.CLAMP_TO_EDGE);
+    linearClamp();
     gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA8, gl.RGBA, gl.UNSIGNED_BYTE, bmp);
     return t;
   }
@@ -563,12 +564,8 @@
     if (estimate) {
       if (!capFbo || capW !== cw || capH !== ch) {
         if (capFbo) { gl.deleteFramebuffer(capFbo); gl.deleteTexture(capTex); }
-        capFbo = gl.createFramebuffer(); capTex = gl.createTexture();
-        gl.bindTexture(gl.TEXTURE_2D, capTex);
-        gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA8, cw, ch);
-        gl.bindFramebuffer(gl.FRAMEBUFFER, capFbo);
-        gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, capTex, 0);
-        capW = cw; capH = ch;
+        const t = colorTarget(cw, ch);
+        capFbo = t.fb; capTex = t.tex; capW = cw; capH = ch;
       }
       fill(capFbo, true);
       gl.bindFramebuffer(gl.FRAMEBUFFER, capFbo);
