@@ -146,7 +146,8 @@ struct sy_web {
     bool quit;
     sy_interactive_input in; /* the orbit and the display filter the pages steer (sy_interactive.h) */
     float lead[2];           /* the last drag's or lead message's lead (pixels; [0, 0]: none) and its */
-    uint32_t lead_button;    /* button: live frames are rendered that much further along (docs/WEB.md) */
+    uint32_t lead_button;    /* button: live frames are rendered that much further along (docs/WEB.md); */
+    uint64_t lead_conn;      /* the connection that sent it (its leaving ends the lead) */
     uint64_t view_version; /* camera, back-end, filter or size changed */
     uint64_t input_gen;    /* inputs received, all clients */
     uint32_t backend;      /* registry index */

@@ -337,7 +337,7 @@ static void ws_message(sy_web *w, web_conn *c, const char *text, size_t len)
         break;
     }
     if (in.type == SY_WEB_INPUT_DRAG || in.type == SY_WEB_INPUT_LEAD) /* what frames lead by from now on */
-        w->lead[0] = (float)in.lead[0], w->lead[1] = (float)in.lead[1], w->lead_button = in.button;
+        w->lead[0] = (float)in.lead[0], w->lead[1] = (float)in.lead[1], w->lead_button = in.button, w->lead_conn = c->serial;
     else if (input) /* the camera moved otherwise (wheel, keys, a saved view): no lead until the next drag */
         w->lead[0] = w->lead[1] = 0.0f;
     if (input) {
@@ -785,6 +785,11 @@ static int ws_callback(struct lws *wsi, enum lws_callback_reasons reason, void *
                 drop_replies_locked(w, c->serial); /* its answers go with it (actions still queued answer nobody) */
                 set_kind(w, c, 0);
                 set_plain(w, c, false);
+                if (w->lead_conn == c->serial && (w->lead[0] != 0.0f || w->lead[1] != 0.0f)) {
+                    w->lead[0] = w->lead[1] = 0.0f; /* its page cannot say its hand rests: the exact view again */
+                    w->view_version++;
+                    pthread_cond_signal(&w->cv);
+                }
                 pthread_mutex_unlock(&w->mu);
                 video_summary(c, "");
                 sy_log(SY_LOG_NOTE, "web", c->peer, "viewer left");

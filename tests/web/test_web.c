@@ -26,7 +26,8 @@
  *                 frame overruns puts the governor at its floor); a "warp" that is no boolean is refused
  *   web_ahead     frames rendered ahead: a drag's "lead" renders its frame that much further on (the
  *                 header's orbit the drag's, the camera led on); a lead of [0, 0] brings the exact view
- *                 back, a lead message alone leads, a wheel ends the lead; not while a viewer does not warp
+ *                 back, a lead message alone leads, a wheel ends the lead, and so does its viewer leaving; not
+ *                 while a viewer does not warp
  *   web_progressive  the path tracer refines while the view rests and restarts when it moves;
  *                 the refinements leave the depth channel out (SAME_DEPTH) and it decodes as before
  *   web_token     listening on 0.0.0.0: without the token 401 with the page saying it is missing,

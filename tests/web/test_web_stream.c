@@ -210,7 +210,8 @@ static int frame_from(sy_web_client *c, const sy_orbit *o, sy_web_frame_info *fi
 /* web_ahead: a drag's lead renders its frame further along (the header's orbit is where the drags
  * put the camera, the frame's camera the orbit moved on by the lead); {"t":"lead","lead":[0,0]}
  * brings the exact view back; a wheel ends the lead; with a viewer whose page does not warp the
- * lead is not used (docs/WEB.md, "Frames rendered ahead") */
+ * lead is not used; the viewer whose lead is in use leaving ends it (docs/WEB.md, "Frames rendered
+ * ahead") */
 int test_ahead(void)
 {
     sy_error err = {0};
@@ -268,6 +269,18 @@ int test_ahead(void)
     } while (fi.input_id < 3);
     CHECK_MSG(camera_off(&fi, &back) < 1e-5f, "with a viewer that does not warp: the camera %g off the drag's", camera_off(&fi, &back));
     sy_web_client_close(d);
+    /* the viewer whose lead is in use leaves (it cannot say its hand rests): the exact view again */
+    CHECK_OK(sy_web_client_connect(&o, 10000, &d, &err), err);
+    CHECK_OK(sy_web_client_send(d, "{\"t\":\"size\",\"w\":64,\"h\":40,\"v\":3,\"warp\":true}", &err), err);
+    CHECK_OK(sy_web_client_next_frame(d, 60000, &fi, NULL, NULL, &err), err);
+    CHECK_OK(sy_web_client_send(d, "{\"t\":\"drag\",\"dx\":5,\"dy\":0,\"lead\":[25,0],\"id\":1}", &err), err);
+    sy_orbit left = back;
+    sy_orbit_rotate(&left, 5, 0);
+    ahead = left;
+    sy_orbit_rotate(&ahead, 25, 0);
+    CHECK_MSG(!frame_from(c, &ahead, &fi), "no frame led by the second viewer's drag");
+    sy_web_client_close(d);
+    CHECK_MSG(!frame_from(c, &left, &fi), "the lead outlived the viewer that sent it");
     sy_web_client_close(c);
     return web_stop(&s);
 }
