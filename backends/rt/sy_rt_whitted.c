@@ -559,14 +559,13 @@ static sy_rt_v3 direct_area(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bs
     return v3_scale(sum, 1.0f / (float)n);
 }
 
-/* Solid angle of triangle t seen from x (Van Oosterom and Strackee). */
-static float tri_solid_angle(const sy_rt_area_tri *t, sy_rt_v3 x)
+/* Triangle t's solid angle seen from x, approximated at its centroid (area x cos / d^2): what a
+ * quad's two triangles share of its samples (only the samples' density: p_sel keeps them
+ * unbiased; the exact form, Van Oosterom and Strackee's, cost 7 % of a render with atan2f). */
+static float tri_solid_angle_approx(const sy_rt_area_tri *t, sy_rt_v3 x)
 {
-    sy_rt_v3 a = v3_sub(t->p0, x), b = v3_add(a, t->e1), c = v3_add(a, t->e2);
-    float la = v3_length(a), lb = v3_length(b), lc = v3_length(c);
-    float num = fabsf(v3_dot(a, v3_cross(b, c)));
-    float den = la * lb * lc + v3_dot(a, b) * lc + v3_dot(a, c) * lb + v3_dot(b, c) * la;
-    float o = 2.0f * atan2f(num, den);
+    sy_rt_v3 v = v3_sub(v3_add(t->p0, v3_scale(v3_add(t->e1, t->e2), 1.0f / 3.0f)), x);
+    float d2 = v3_dot(v, v), o = t->area * fabsf(v3_dot(t->normal, v)) / (d2 * sqrtf(d2));
     return isfinite(o) && o > 0.0f ? o : 0.0f;
 }
 
@@ -696,7 +695,7 @@ static sy_rt_v3 direct_area_analytic(trace_ctx *c, const sy_rt_surface *s, const
         float w_dir; /* 1 / the direction's pdf (solid angle) */
         if (pg->nv == 4u) {
             const sy_rt_area_tri *t1 = &dev->area[pg->tri[1]];
-            float o0 = tri_solid_angle(t, s->p), o1 = tri_solid_angle(t1, s->p);
+            float o0 = tri_solid_angle_approx(t, s->p), o1 = tri_solid_angle_approx(t1, s->p);
             float split = o0 + o1 > 0.0f ? o0 / (o0 + o1) : pg->split;
             if (ut < split) p_sel *= split;
             else t = t1, p_sel *= 1.0f - split;
