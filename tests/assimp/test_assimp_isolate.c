@@ -234,5 +234,6 @@ int main(void)
     if (cd) closedir(cd);
 
     remove_scratch_dir(dir);
+    EXPECT_MSG(access(dir, F_OK) != 0, "the scratch folder %s and its nested folders are removed", dir);
     return sy_check_finish("test_assimp_isolate");
 }

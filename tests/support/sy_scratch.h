@@ -1,9 +1,10 @@
 /* sy_scratch.h — the tests' private scratch folders: made fresh under $TMPDIR (/tmp without it) as
- * sy_TAG_XXXXXX, removed at the end. Test-only, header-only; main thread only. */
+ * sy_TAG_XXXXXX, removed with all they hold at the end. Test-only, header-only; main thread only. */
 #ifndef SY_TEST_SY_SCRATCH_H
 #define SY_TEST_SY_SCRATCH_H
 
 #include <dirent.h>
+#include <sys/stat.h>
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -22,17 +23,20 @@ static inline void make_scratch_dir(char *buf, size_t n, const char *tag)
     }
 }
 
-/* Removes the plain files in dir, then dir itself (scratch folders are flat). */
+/* Removes dir and everything under it (the assimp tests nest folders in theirs); symbolic links
+ * are removed, not followed. */
 static inline void remove_scratch_dir(const char *dir)
 {
     DIR *d = opendir(dir);
     if (d) {
         struct dirent *e;
         char p[4096];
+        struct stat st;
         while ((e = readdir(d)) != NULL) {
             if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0) continue;
             if (snprintf(p, sizeof p, "%s/%s", dir, e->d_name) >= (int)sizeof p) continue;
-            if (unlink(p) != 0) rmdir(p);
+            if (lstat(p, &st) == 0 && S_ISDIR(st.st_mode)) remove_scratch_dir(p);
+            else unlink(p);
         }
         closedir(d);
     }
