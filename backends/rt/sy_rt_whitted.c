@@ -120,15 +120,17 @@ typedef struct trace_ctx {
     uint32_t sample; /* pixel sample index */
     sy_rt_v3 eye;    /* the camera ray's origin */
     psample *cur;    /* this camera sample's record (its depth-0 hit fills it) */
-    /* The analytic area light of the pixel's first camera hit, reused by its other camera hits on
-     * the same instance with the same normal and material model (within 1 %) within a hundredth
-     * of the eye distance (the unshadowed light varies far less over a pixel than its shadows) */
+    /* The analytic area light of the pixel's first camera hit per lobe (without the albedos, which
+     * textures vary within a pixel), reused by its other camera hits on the same instance with the
+     * same normal and lobes (roughness within 0.01) within a hundredth of the eye distance (the
+     * unshadowed light varies far less over a pixel than its shadows) */
     struct {
         bool valid;
         const void *inst;
-        sy_rt_v3 p, n, a;
-        sy_rt_v3 kd, fl; /* the model it was computed with (textures vary it within a pixel) */
-        float rough, fc;
+        sy_rt_v3 p, n;
+        sy_rt_v3 lobe[3]; /* per lobe (amodel's diffuse, base, coat): the emitters' sum */
+        bool spec, coat;  /* the lobes it was computed with */
+        float rough, rough_c;
         float cdf[ANALYTIC_MAX_TRIANGLES + 1u];
     } cache;
 } trace_ctx;
@@ -184,11 +186,14 @@ static void ltc_fetch(const float *tab, float u, float v, float out[4])
 }
 
 /* The closed-form model of a shading point's BSDF: Lambert (plus the sheen, as diffuse light) and
- * GGX lobes with the LTC tables' albedos. m: world -> the lobe's cosine space (row-major). */
+ * GGX lobes with the LTC tables' albedos. The lobes' transforms (minv, minv_c: world -> the lobe's
+ * cosine space, row-major) only where an emitter's polygons need them (amodel_matrices): the
+ * environment's split sum and a cached polygon light need only the albedos. */
 typedef struct amodel {
     sy_rt_v3 kd;        /* diffuse albedo (x the form factor / irradiance) */
     sy_rt_v3 fl;        /* the base's GGX albedo */
-    float frame[9];     /* world -> (T1, T2, N): the diffuse lobe */
+    sy_rt_v3 n, nc, wo; /* the shading normal, the coat's, the view */
+    bool mats;          /* minv and minv_c are set */
     float minv[9];      /* the base's GGX lobe (0 rows when fl = 0) */
     sy_rt_v3 r_dir;     /* where the base's lobe looks into the prefiltered environment */
     float rough;
@@ -208,16 +213,18 @@ static void make_frame(sy_rt_v3 n, sy_rt_v3 wo, float fr[9])
     fr[0] = t1.x, fr[1] = t1.y, fr[2] = t1.z, fr[3] = t2.x, fr[4] = t2.y, fr[5] = t2.z, fr[6] = n.x, fr[7] = n.y, fr[8] = n.z;
 }
 
-/* One GGX lobe of perceptual roughness r seen at n . wo = nv: its M^-1 x frame and its albedo
- * terms (t2[0] F0 + t2[1] (1 - F0)). */
-static void ggx_lobe(sy_rt_v3 n, sy_rt_v3 wo, float r, float m[9], float t2[4])
+/* The table coordinate of the view: sqrt(1 - n . wo). */
+static float ggx_v(sy_rt_v3 n, sy_rt_v3 wo) { return sqrtf(1.0f - sy_rt_clampf(v3_dot(n, wo), 0.0f, 1.0f)); }
+
+/* One GGX lobe of perceptual roughness r seen from wo: its albedo terms (t2[0] F0 + t2[1] (1 - F0)). */
+static void ggx_albedo(sy_rt_v3 n, sy_rt_v3 wo, float r, float t2[4]) { ltc_fetch(g_ltc2, r, ggx_v(n, wo), t2); }
+
+/* The same lobe's M^-1 x frame. */
+static void ggx_matrix(sy_rt_v3 n, sy_rt_v3 wo, float r, float m[9])
 {
     float fr[9], t1[4];
-    float nv = sy_rt_clampf(v3_dot(n, wo), 0.0f, 1.0f);
     make_frame(n, wo, fr);
-    float v = sqrtf(1.0f - nv);
-    ltc_fetch(g_ltc1, r, v, t1);
-    ltc_fetch(g_ltc2, r, v, t2);
+    ltc_fetch(g_ltc1, r, ggx_v(n, wo), t1);
     /* M^-1 = rows (a, 0, c), (0, 1, 0), (b, 0, d) (the GLSL mat3 of columns (a,0,b), (0,1,0), (c,0,d)) */
     for (int j = 0; j < 3; ++j) {
         m[0 + j] = t1[0] * fr[0 + j] + t1[2] * fr[6 + j];
@@ -234,18 +241,18 @@ static sy_rt_v3 dominant_dir(sy_rt_v3 n, sy_rt_v3 wo, float alpha)
     return v3_normalize(v3_add(v3_scale(n, 1.0f - f), v3_scale(r, f)));
 }
 
-/* The model of BSDF b; false when it has lobes the model does not describe (iridescence,
- * anisotropy): those keep the sampled estimates. */
+/* The model of BSDF b, its albedos (amodel_matrices adds the lobes' transforms); false when it has
+ * lobes the model does not describe (iridescence, anisotropy): those keep the sampled estimates. */
 static bool amodel_init(amodel *m, const sy_rt_bsdf *b, sy_rt_v3 wo)
 {
     if (b->irid > 0.0f || b->aniso) return false;
     pthread_once(&g_ltc_once, ltc_load);
     float nv = sy_rt_clampf(v3_dot(b->n, wo), 1e-4f, 1.0f);
-    make_frame(b->n, wo, m->frame);
+    m->n = b->n, m->wo = wo, m->mats = false;
     m->rough = sqrtf(b->alpha);
     m->fl = v3(0.0f, 0.0f, 0.0f);
     float t2[4] = {0, 0, 0, 0};
-    ggx_lobe(b->n, wo, m->rough, m->minv, t2);
+    ggx_albedo(b->n, wo, m->rough, t2);
     sy_rt_v3 fd = v3_scale(v3_add(v3_scale(b->f0c, t2[0]), v3_scale(v3_sub(v3(1.0f, 1.0f, 1.0f), b->f0c), t2[1])), b->spec);
     if (!b->delta) {
         sy_rt_v3 fm = v3_add(v3_scale(b->base, t2[0]), v3_scale(v3_sub(v3(1.0f, 1.0f, 1.0f), b->base), t2[1]));
@@ -256,16 +263,24 @@ static bool amodel_init(amodel *m, const sy_rt_bsdf *b, sy_rt_v3 wo)
     m->kd = v3_scale(b->base, b->w_diel * (1.0f - fdm));
     if (b->q_sheen > 0.0f) m->kd = v3_add(m->kd, v3_scale(b->sheen, sy_rt_sheen_albedo(nv, b->sheen_r)));
     m->r_dir = dominant_dir(b->n, wo, b->alpha);
-    m->fc = 0.0f;
+    m->fc = 0.0f, m->rough_c = 0.0f, m->nc = b->n, m->rc_dir = m->r_dir;
     if (b->cc > 0.0f && !b->cc_delta && b->q_coat > 0.0f) {
-        sy_rt_v3 nc = b->cc_n ? b->ncc : b->n;
+        m->nc = b->cc_n ? b->ncc : b->n;
         float tc[4];
         m->rough_c = sqrtf(b->cc_alpha);
-        ggx_lobe(nc, wo, m->rough_c, m->minv_c, tc);
+        ggx_albedo(m->nc, wo, m->rough_c, tc);
         m->fc = b->cc * (0.04f * tc[0] + 0.96f * tc[1]);
-        m->rc_dir = dominant_dir(nc, wo, b->cc_alpha);
+        m->rc_dir = dominant_dir(m->nc, wo, b->cc_alpha);
     }
     return true;
+}
+
+static void amodel_matrices(amodel *m)
+{
+    if (m->mats) return;
+    ggx_matrix(m->n, m->wo, m->rough, m->minv);
+    if (m->fc > 0.0f) ggx_matrix(m->nc, m->wo, m->rough_c, m->minv_c);
+    m->mats = true;
 }
 
 /* An emitter for the closed form: one emissive triangle, or two coplanar ones sharing an edge with
@@ -449,32 +464,46 @@ static float lobe_value(float fz, float len, float above)
     return len * t[3];
 }
 
-/* Unshadowed light from every polygon at the shading point x (out[i]; 0 behind a one-sided emitter,
- * in its plane or wholly under the horizon). The diffuse lobe is the cosine itself: its integral in
- * world space (a rotation changes neither the edge vectors' lengths nor z = their sum . n). */
-static void area_unshadowed_all(const amodel *m, const apoly *poly, const apoly_soa *q, uint32_t n, sy_rt_v3 x,
-                                sy_rt_v3 *out)
+/* Unshadowed light from every polygon at the shading point x, per lobe and without the albedos:
+ * lv[l][i] for lobe l (0 diffuse, 1 the base's GGX, 2 the coat's; 1 and 2 only where m has them)
+ * and polygon i; 0 behind a one-sided emitter, in its plane or wholly under the horizon. Only the
+ * polygons that light x go through lobe_forms (packed into their own arrays: behind a cube's faces
+ * half of them do not). The diffuse lobe is the cosine itself: its integral in world space (a
+ * rotation changes neither the edge vectors' lengths nor z = their sum . n). */
+static void area_unshadowed_all(amodel *m, const apoly_soa *q, uint32_t n, sy_rt_v3 x,
+                                float lv[3][ANALYTIC_MAX_TRIANGLES])
 {
     float ok[ANALYTIC_MAX_TRIANGLES], fz[3][ANALYTIC_MAX_TRIANGLES], len[3][ANALYTIC_MAX_TRIANGLES];
     float above[3][ANALYTIC_MAX_TRIANGLES], below[ANALYTIC_MAX_TRIANGLES], unused[ANALYTIC_MAX_TRIANGLES];
-    sy_rt_v3 nn = v3(m->frame[6], m->frame[7], m->frame[8]);
+    uint32_t idx[ANALYTIC_MAX_TRIANGLES], np = 0;
+    apoly_soa pk; /* the polygons that light x (vertices and quad only) */
+    sy_rt_v3 nn = m->n;
     bool spec = !v3_is_zero(m->fl), coat = m->fc > 0.0f;
     poly_facing(q, n, x.x, x.y, x.z, ok);
-    lobe_forms(q, n, x.x, x.y, x.z, NULL, nn.x, nn.y, nn.z, fz[0], len[0], above[0], below);
-    if (spec) lobe_forms(q, n, x.x, x.y, x.z, m->minv, 0.0f, 0.0f, 0.0f, fz[1], len[1], above[1], unused);
-    if (coat) lobe_forms(q, n, x.x, x.y, x.z, m->minv_c, 0.0f, 0.0f, 0.0f, fz[2], len[2], above[2], unused);
     for (uint32_t i = 0; i < n; ++i) {
-        if (!(ok[i] > 0.0f) || below[i] > 0.0f) {
-            out[i] = v3(0.0f, 0.0f, 0.0f);
-            continue;
-        }
-        sy_rt_v3 w = v3_scale(m->kd, lobe_value(fz[0][i], len[0][i], above[0][i]));
-        if (spec) w = v3_add(w, v3_scale(m->fl, lobe_value(fz[1][i], len[1][i], above[1][i])));
-        if (coat) {
-            float c = m->fc * lobe_value(fz[2][i], len[2][i], above[2][i]);
-            w = v3_add(w, v3(c, c, c));
-        }
-        out[i] = v3_mul(w, poly[i].emission);
+        lv[0][i] = lv[1][i] = lv[2][i] = 0.0f;
+        if (!(ok[i] > 0.0f)) continue;
+        for (int k = 0; k < 4; ++k) pk.x[k][np] = q->x[k][i], pk.y[k][np] = q->y[k][i], pk.z[k][np] = q->z[k][i];
+        pk.quad[np] = q->quad[i];
+        idx[np++] = i;
+    }
+    if (np == 0) return;
+    /* whole vector steps (8 lanes): the last polygon repeated, its copies' results unused */
+    uint32_t nv = (np + 7u) & ~7u;
+    for (uint32_t j = np; j < nv; ++j) {
+        for (int k = 0; k < 4; ++k) pk.x[k][j] = pk.x[k][np - 1u], pk.y[k][j] = pk.y[k][np - 1u], pk.z[k][j] = pk.z[k][np - 1u];
+        pk.quad[j] = pk.quad[np - 1u];
+    }
+    if (spec || coat) amodel_matrices(m);
+    lobe_forms(&pk, nv, x.x, x.y, x.z, NULL, nn.x, nn.y, nn.z, fz[0], len[0], above[0], below);
+    if (spec) lobe_forms(&pk, nv, x.x, x.y, x.z, m->minv, 0.0f, 0.0f, 0.0f, fz[1], len[1], above[1], unused);
+    if (coat) lobe_forms(&pk, nv, x.x, x.y, x.z, m->minv_c, 0.0f, 0.0f, 0.0f, fz[2], len[2], above[2], unused);
+    for (uint32_t j = 0; j < np; ++j) {
+        if (below[j] > 0.0f) continue;
+        uint32_t i = idx[j];
+        lv[0][i] = lobe_value(fz[0][j], len[0][j], above[0][j]);
+        if (spec) lv[1][i] = lobe_value(fz[1][j], len[1][j], above[1][j]);
+        if (coat) lv[2][i] = lobe_value(fz[2][j], len[2][j], above[2][j]);
     }
 }
 
@@ -626,23 +655,11 @@ static bool sample_tri(const sy_rt_area_tri *t, sy_rt_v3 x, float u1, float u2, 
     return true;
 }
 
-/* The cached model equals m within 1 % (albedos) and 0.01 (roughness). */
-static bool near3(sy_rt_v3 a, sy_rt_v3 b)
-{
-    return fabsf(a.x - b.x) <= 0.01f * fabsf(b.x) + 1e-6f && fabsf(a.y - b.y) <= 0.01f * fabsf(b.y) + 1e-6f &&
-           fabsf(a.z - b.z) <= 0.01f * fabsf(b.z) + 1e-6f;
-}
-
-static bool same_model(const sy_rt_v3 *kd, const sy_rt_v3 *fl, float rough, float fc, const amodel *m)
-{
-    return near3(*kd, m->kd) && near3(*fl, m->fl) && fabsf(rough - m->rough) <= 0.01f && fabsf(fc - m->fc) <= 0.01f * m->fc + 1e-6f;
-}
-
 /* Area lights with the model m: the analytic unshadowed light of every emissive triangle, and
  * n_area samples, each picking a polygon in proportion to its analytic light (luminance) and a
  * direction uniform in its solid angle, for the visibility ratio (with weights nearly constant
  * over the emitter, the ratio of few samples is nearly the visibility the BSDF sees). */
-static sy_rt_v3 direct_area_analytic(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bsdf *b, const amodel *m,
+static sy_rt_v3 direct_area_analytic(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bsdf *b, amodel *m,
                                      sy_rt_v3 p_off, sy_rt_v3 wo, uint32_t depth)
 {
     const sy_rt_device *dev = c->dev;
@@ -650,25 +667,37 @@ static sy_rt_v3 direct_area_analytic(trace_ctx *c, const sy_rt_surface *s, const
     uint32_t nt = c->job->n_poly;
     float local[ANALYTIC_MAX_TRIANGLES + 1u]; /* a secondary hit's table (the cache is the camera hit's) */
     float *cdf = c->cache.cdf;
-    sy_rt_v3 a = c->cache.a;
-    bool cam = depth == 0u;
+    sy_rt_v3 lobe[3] = {c->cache.lobe[0], c->cache.lobe[1], c->cache.lobe[2]};
+    bool cam = depth == 0u, spec = !v3_is_zero(m->fl), coat = m->fc > 0.0f;
     if (!(cam && c->cache.valid && c->cache.inst == (const void *)s->inst && v3_dot(c->cache.n, b->n) > 0.9995f &&
-          v3_length(v3_sub(c->cache.p, s->p)) <= 0.01f * v3_length(v3_sub(s->p, c->eye)) &&
-          same_model(&c->cache.kd, &c->cache.fl, c->cache.rough, c->cache.fc, m))) {
+          v3_length(v3_sub(c->cache.p, s->p)) <= 0.01f * v3_length(v3_sub(s->p, c->eye)) && c->cache.spec == spec &&
+          c->cache.coat == coat && (!spec || fabsf(c->cache.rough - m->rough) <= 0.01f) &&
+          (!coat || fabsf(c->cache.rough_c - m->rough_c) <= 0.01f))) {
         if (!cam) cdf = local;
-        a = v3(0.0f, 0.0f, 0.0f);
+        lobe[0] = lobe[1] = lobe[2] = v3(0.0f, 0.0f, 0.0f);
         cdf[0] = 0.0f;
-        sy_rt_v3 ai[ANALYTIC_MAX_TRIANGLES];
-        area_unshadowed_all(m, poly, c->job->pv, nt, s->p, ai);
+        float lv[3][ANALYTIC_MAX_TRIANGLES];
+        area_unshadowed_all(m, c->job->pv, nt, s->p, lv);
         for (uint32_t i = 0; i < nt; ++i) {
-            a = v3_add(a, ai[i]);
-            cdf[i + 1u] = cdf[i] + sy_rt_maxf(v3_luminance(ai[i]), 0.0f);
+            if (lv[0][i] == 0.0f && lv[1][i] == 0.0f && lv[2][i] == 0.0f) {
+                cdf[i + 1u] = cdf[i];
+                continue;
+            }
+            sy_rt_v3 e = poly[i].emission;
+            for (int l = 0; l < 3; ++l) lobe[l] = v3_add(lobe[l], v3_scale(e, lv[l][i]));
+            /* polygons picked in proportion to their light with this point's albedos (the
+             * cache's other points keep the table: only the samples' density) */
+            sy_rt_v3 ai = v3_mul(v3_add(v3_add(v3_scale(m->kd, lv[0][i]), v3_scale(m->fl, lv[1][i])),
+                                        v3_scale(v3(m->fc, m->fc, m->fc), lv[2][i])), e);
+            cdf[i + 1u] = cdf[i] + sy_rt_maxf(v3_luminance(ai), 0.0f);
         }
         if (cam) {
-            c->cache.valid = true, c->cache.inst = s->inst, c->cache.p = s->p, c->cache.n = b->n, c->cache.a = a;
-            c->cache.kd = m->kd, c->cache.fl = m->fl, c->cache.rough = m->rough, c->cache.fc = m->fc;
+            c->cache.valid = true, c->cache.inst = s->inst, c->cache.p = s->p, c->cache.n = b->n;
+            for (int l = 0; l < 3; ++l) c->cache.lobe[l] = lobe[l];
+            c->cache.spec = spec, c->cache.coat = coat, c->cache.rough = m->rough, c->cache.rough_c = m->rough_c;
         }
     }
+    sy_rt_v3 a = v3_add(v3_add(v3_mul(m->kd, lobe[0]), v3_mul(m->fl, lobe[1])), v3_scale(lobe[2], m->fc));
     float total = cdf[nt];
     if (!(total > 0.0f)) return v3(0.0f, 0.0f, 0.0f);
     uint32_t n = c->job->n_area;
@@ -682,8 +711,11 @@ static sy_rt_v3 direct_area_analytic(trace_ctx *c, const sy_rt_surface *s, const
         if (k < n) light_u(c, SET_AREA(depth), n, k, u);
         else sy_rt_sobol_sample4(c->job->sobol, c->pseed ^ 0x5bd1e995u, SET_AREA(depth), c->sample * RETRIES + (k - n), u);
         float xi = u[0] * total;
-        uint32_t i = 0;
-        while (i + 1u < nt && cdf[i + 1u] <= xi) ++i;
+        uint32_t i = 0, hi = nt; /* the last i with cdf[i] <= xi below nt */
+        while (i + 1u < hi) {
+            uint32_t mid = (i + hi) / 2u;
+            if (cdf[mid] <= xi) i = mid; else hi = mid;
+        }
         float p_sel = (cdf[i + 1u] - cdf[i]) / total;
         if (!(p_sel > 0.0f)) continue;
         /* one of the polygon's triangles by solid angle (u[0] rescaled), a direction uniform in
