@@ -85,6 +85,15 @@ static uint32_t wrap_index(int64_t i, uint32_t n, sy_rt_wrap mode)
     }
 }
 
+/* The wrapped index of i + 1 from w, the wrapped index of i: repeat and clamp without a second
+ * division (bilinear taps are neighbours). */
+static uint32_t wrap_next(int64_t i, uint32_t w, uint32_t n, sy_rt_wrap mode)
+{
+    if (mode == SY_RT_WRAP_REPEAT) return w + 1u == n ? 0u : w + 1u;
+    if (mode == SY_RT_WRAP_CLAMP) return i + 1 < 0 ? 0u : (i + 1 >= (int64_t)n ? n - 1u : (uint32_t)(i + 1));
+    return wrap_index(i + 1, n, mode);
+}
+
 static void fetch(const sy_rt_texture_data *t, uint32_t x, uint32_t y, float out[4])
 {
     size_t base = ((size_t)y * t->width + x) * t->channels;
@@ -127,8 +136,8 @@ void sy_rt_texture_sample(const sy_rt_texture_data *t, float u, float v, float o
     double fx0 = floor(x), fy0 = floor(y);
     float fx = (float)(x - fx0), fy = (float)(y - fy0);
     int64_t ix = (int64_t)fx0, iy = (int64_t)fy0;
-    uint32_t x0 = wrap_index(ix, t->width, t->wrap_s), x1 = wrap_index(ix + 1, t->width, t->wrap_s);
-    uint32_t y0 = wrap_index(iy, t->height, t->wrap_t), y1 = wrap_index(iy + 1, t->height, t->wrap_t);
+    uint32_t x0 = wrap_index(ix, t->width, t->wrap_s), x1 = wrap_next(ix, x0, t->width, t->wrap_s);
+    uint32_t y0 = wrap_index(iy, t->height, t->wrap_t), y1 = wrap_next(iy, y0, t->height, t->wrap_t);
     float a[4], b[4], c[4], d[4];
     fetch(t, x0, y0, a); fetch(t, x1, y0, b); fetch(t, x0, y1, c); fetch(t, x1, y1, d);
     for (int k = 0; k < 4; ++k) {
