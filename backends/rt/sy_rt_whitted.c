@@ -598,12 +598,6 @@ static float tri_solid_angle_approx(const sy_rt_area_tri *t, sy_rt_v3 x)
     return isfinite(o) && o > 0.0f ? o : 0.0f;
 }
 
-static float angle_between(sy_rt_v3 a, sy_rt_v3 b)
-{
-    if (v3_dot(a, b) < 0.0f) return 3.14159265f - 2.0f * asinf(sy_rt_minf(v3_length(v3_add(a, b)) * 0.5f, 1.0f));
-    return 2.0f * asinf(sy_rt_minf(v3_length(v3_sub(b, a)) * 0.5f, 1.0f));
-}
-
 static sy_rt_v3 gram_schmidt(sy_rt_v3 v, sy_rt_v3 w) { return v3_sub(v, v3_scale(w, v3_dot(v, w))); }
 
 /* A direction wi from x toward triangle t, uniform in its solid angle (Arvo 1995, as pbrt-v4
@@ -614,19 +608,19 @@ static bool sample_tri(const sy_rt_area_tri *t, sy_rt_v3 x, float u1, float u2, 
 {
     sy_rt_v3 p1 = v3_add(t->p0, t->e1), p2 = v3_add(t->p0, t->e2);
     sy_rt_v3 a = v3_normalize(v3_sub(t->p0, x)), b = v3_normalize(v3_sub(p1, x)), c = v3_normalize(v3_sub(p2, x));
-    sy_rt_v3 nab = v3_cross(a, b), nbc = v3_cross(b, c), nca = v3_cross(c, a);
-    float lab = v3_length(nab), lbc = v3_length(nbc), lca = v3_length(nca);
-    float area_sa = 0.0f;
-    if (lab > 1e-6f && lbc > 1e-6f && lca > 1e-6f) {
-        nab = v3_scale(nab, 1.0f / lab), nbc = v3_scale(nbc, 1.0f / lbc), nca = v3_scale(nca, 1.0f / lca);
-        float alpha = angle_between(nab, v3_scale(nca, -1.0f)), beta = angle_between(nbc, v3_scale(nab, -1.0f));
-        float gamma = angle_between(nca, v3_scale(nbc, -1.0f));
-        float a_pi = alpha + beta + gamma;
-        area_sa = a_pi - 3.14159265f;
-        if (area_sa > 1e-4f && isfinite(area_sa)) {
-            float ap_pi = 3.14159265f + u1 * area_sa;
-            float ca = cosf(alpha), sa = sinf(alpha);
-            float sphi = sinf(ap_pi) * ca - cosf(ap_pi) * sa, cphi = cosf(ap_pi) * ca + sinf(ap_pi) * sa;
+    sy_rt_v3 nab = v3_cross(a, b), nca = v3_cross(c, a);
+    float lab = v3_length(nab), lca = v3_length(nca);
+    /* the solid angle (spherical excess) by Van Oosterom and Strackee's tan(E / 2) = |a . (b x c)| /
+     * (1 + a.b + b.c + c.a): one atan2f, and exact for small triangles where the sum of the three
+     * angles minus pi loses its digits */
+    float area_sa = 2.0f * atan2f(fabsf(v3_dot(a, v3_cross(b, c))), 1.0f + v3_dot(a, b) + v3_dot(b, c) + v3_dot(c, a));
+    if (lab > 1e-6f && lca > 1e-6f) {
+        /* alpha, the angle at a: between the planes (a, b) and (a, c) */
+        float ca = sy_rt_clampf(-v3_dot(nab, nca) / (lab * lca), -1.0f, 1.0f), sa = sqrtf(1.0f - ca * ca);
+        if (area_sa > 1e-4f && isfinite(area_sa) && sa > 0.0f) {
+            float sx, cx; /* sin and cos of pi + u1 area_sa: -sin, -cos of u1 area_sa */
+            sx = sinf(u1 * area_sa), cx = cosf(u1 * area_sa);
+            float sphi = -sx * ca + cx * sa, cphi = -cx * ca - sx * sa;
             float k1 = cphi + ca, k2 = sphi - sa * v3_dot(a, b);
             float cbp = (k2 + (k2 * cphi - k1 * sphi) * ca) / ((k2 * sphi + k1 * cphi) * sa);
             cbp = sy_rt_clampf(isfinite(cbp) ? cbp : 1.0f, -1.0f, 1.0f);
