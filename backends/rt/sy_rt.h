@@ -624,7 +624,9 @@ typedef struct sy_rt_render_desc {
                                          * pixel, shared among its pixel samples (each shading point
                                          * takes ceil(n / pixel_samples)); they sample only the
                                          * visibility of the closed-form light (up to 64 untextured
-                                         * emissive triangles); 0 = 16 */
+                                         * emissive triangles); 0 = 8 there, 16 where they sample
+                                         * the light itself (more or textured emitters, the light
+                                         * tree) */
     uint32_t seed;                      /**< decorrelates sample patterns; same seed = same image */
     /** WHITTED only: */
     uint32_t pixel_samples;             /**< anti-aliasing: camera rays per pixel through stratified

@@ -151,7 +151,7 @@ sy_rt_result sy_rt_frame_init(sy_rt_frame *f, const sy_rt_device *dev, const sy_
     f->height = d->height;
     f->integrator = d->integrator;
     f->max_depth = d->max_depth ? d->max_depth : 8u;
-    f->light_samples = d->area_light_samples ? d->area_light_samples : 16u;
+    f->light_samples = d->area_light_samples; /* 0: the integrator's default */
     f->seed = d->seed;
     f->rgba = rgba;
     f->depth = depth;

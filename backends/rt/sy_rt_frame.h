@@ -19,7 +19,7 @@ typedef struct sy_rt_frame {
     uint32_t image_width, image_height;
     uint32_t x, y, width, height;          /* output rectangle in full-image pixels */
     sy_rt_integrator integrator;
-    uint32_t max_depth, light_samples, seed;
+    uint32_t max_depth, light_samples, seed; /* light_samples 0: the integrator's default */
     float *rgba, *depth;                   /* output, row 0 = top of the rectangle */
     /* motion blur of the camera (sy_rt_render_desc.camera_close, camera_mid): the camera above at ray
      * time 0 (cam_step[0]), cam_step[k] at time k / (cam_steps - 1); cam_motion false when there is

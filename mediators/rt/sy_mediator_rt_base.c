@@ -19,8 +19,8 @@
  * pt_filter_kind, "rf_kernel" sy_filter_rf_kernel, "filter_kernel" separable, brute. */
 #define RT_COMMON_PARAMS(depth_default, depth_max, depth_help)                                                      \
     {"max_depth", SY_PARAM_INT, 1, depth_max, depth_default, NULL, depth_help, 0},                                  \
-    {"light_samples", SY_PARAM_INT, 1, 1024, "16", NULL, "area-light samples per pixel, shared by its pixel samples", \
-     0},                                                                                                             \
+    {"light_samples", SY_PARAM_INT, 0, 1024, "0", NULL, "area-light samples per pixel, shared by its pixel samples " \
+     "(0: 8 where they sample only the visibility of the closed-form light, else 16)", 0},                           \
     {"threads", SY_PARAM_INT, 0, 1024, "0", NULL, "worker threads (0 = OpenMP's default: OMP_NUM_THREADS, else all cores)", 0},                             \
     {"specular", SY_PARAM_FLOAT, 0, 1, "1", NULL,                                                                   \
      "KHR_materials_specular factor of every material (0: dielectrics purely Lambertian)", 0},                       \

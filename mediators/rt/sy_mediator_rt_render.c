@@ -127,7 +127,8 @@ static sy_result render_frame(rt_state *st, const sy_render_request *req, sy_lay
         /* an interactive preview (SY_CAP_PREVIEW): the share `preview` of the camera rays and of the
          * area- and environment-light samples per pixel, at least one each (spp=1 is the pixel centre) */
         d.pixel_samples = (uint32_t)fmaxf(1.0f, floorf((float)st->pixel_samples * req->preview + 0.5f));
-        d.area_light_samples = (uint32_t)fmaxf(1.0f, floorf((float)st->light_samples * req->preview + 0.5f));
+        /* (light_samples 0, the default: a share of the closed form's 8) */
+        d.area_light_samples = (uint32_t)fmaxf(1.0f, floorf((float)(st->light_samples ? st->light_samples : 8u) * req->preview + 0.5f));
         d.env_light_samples = (uint32_t)fmaxf(1.0f, floorf((float)st->env_samples * req->preview + 0.5f));
     }
     if (st->integrator == SY_RT_INTEGRATOR_COVERAGE) return sy_rti_coverage_render(st, &cam, &d, layer, err);
