@@ -706,11 +706,8 @@ static sy_rt_v3 direct_area_analytic(trace_ctx *c, const sy_rt_surface *s, const
         if (k < n) light_u(c, SET_AREA(depth), n, k, u);
         else sy_rt_sobol_sample4(c->job->sobol, c->pseed ^ 0x5bd1e995u, SET_AREA(depth), c->sample * RETRIES + (k - n), u);
         float xi = u[0] * total;
-        uint32_t i = 0, hi = nt; /* the last i with cdf[i] <= xi below nt */
-        while (i + 1u < hi) {
-            uint32_t mid = (i + hi) / 2u;
-            if (cdf[mid] <= xi) i = mid; else hi = mid;
-        }
+        uint32_t i = 0; /* the last i below nt with cdf[i] <= xi (binary search; a select, not a branch) */
+        for (uint32_t len = nt; len > 1u; len -= len / 2u) i = cdf[i + len / 2u] <= xi ? i + len / 2u : i;
         float p_sel = (cdf[i + 1u] - cdf[i]) / total;
         if (!(p_sel > 0.0f)) continue;
         /* one of the polygon's triangles by solid angle (u[0] rescaled), a direction uniform in
