@@ -85,8 +85,8 @@ sy_result gltf_read_floats(loader *L, size_t ai, size_t out_comps, float **out)
         if (out_comps == 4 && comps < 4) dst[3] = 1.0f;
     }
     for (size_t k = 0; a->sparse && r == SY_OK && k < (size_t)a->sparse_count; k++) {
-        size_t t;
-        const uint8_t *p;
+        size_t t = 0; /* set by sparse_entry on success (GCC -O3 cannot tell) */
+        const uint8_t *p = NULL;
         if ((r = sparse_entry(L, ai, k, &t, &p)) == SY_OK)
             for (size_t c = 0; c < comps; c++) f[t * out_comps + c] = load_component(p + c * cs, a->component_type, norm);
     }
@@ -109,8 +109,8 @@ sy_result gltf_read_element(loader *L, size_t ai, size_t i, size_t out_comps, fl
     if (out_comps == 4 && comps < 4) dst[3] = 1.0f;
     if (a->sparse) {
         for (size_t k = 0; k < (size_t)a->sparse_count; k++) {
-            size_t t;
-            const uint8_t *q;
+            size_t t = 0; /* set by sparse_entry on success (GCC -O3 cannot tell) */
+            const uint8_t *q = NULL;
             sy_result r = sparse_entry(L, ai, k, &t, &q);
             if (r) return r;
             if (t != i) continue;
@@ -133,8 +133,8 @@ sy_result gltf_read_uints(loader *L, size_t ai, uint32_t **out)
         u[i] = p ? load_uint(p, a->component_type) : 0;
     }
     for (size_t k = 0; a->sparse && r == SY_OK && k < (size_t)a->sparse_count; k++) {
-        size_t t;
-        const uint8_t *p;
+        size_t t = 0; /* set by sparse_entry on success (GCC -O3 cannot tell) */
+        const uint8_t *p = NULL;
         if ((r = sparse_entry(L, ai, k, &t, &p)) == SY_OK) u[t] = load_uint(p, a->component_type);
     }
     if (r == SY_OK) *out = u;
