@@ -17,7 +17,7 @@ _sy_common="--help -q --quiet -v --verbose --env --env-color --env-intensity --e
 _sy_cluster="--cluster --cluster-mode --secret-file --tls-ca --timeout-ms --cluster-pixels"
 # options that take a value (the next word)
 _sy_with_value=" -b -o -w -h --camera --look-at --orbit --fov --bookmark --bookmarks --clip-cap --plane --hide --isolate --select --params --at --clip --max-memory --gl --filter --threshold --exposure --tonemap --stereo --eye-sep
-  --shutter --shutter-samples --shutter-steps --zero-parallax --overlay --composite --frames --fps --repeat --spp --time --cluster --cluster-mode --secret-file --tls-ca
+  --shutter --shutter-samples --shutter-steps --zero-parallax --overlay --composite --frames --fps --repeat --spp --seed --time --cluster --cluster-mode --secret-file --tls-ca
   --timeout-ms --cluster-pixels --screenshot --keys --top --backends --repeats --nodes --tris --reference --env
   --env-color --env-intensity --background --allow-path --max-scene-mb --variant --listen --output --port-file --tls-cert --tls-key --name
   --max-sessions --max-lifetime --blob-cache-mb --max-objects --auth-backoff-ms --max-peer-memory-mb
@@ -27,7 +27,7 @@ _sy_with_value=" -b -o -w -h --camera --look-at --orbit --fov --bookmark --bookm
 _sy_options() {
     case "${1:-}" in
     render) echo "-b -o -w -h --camera --look-at --orbit --fov --bookmark --hide --isolate --select --params --at --clip --clip-cap --max-memory --gl --filter --threshold --half --exposure --tonemap --stereo
-                  --eye-sep --zero-parallax --overlay --composite --frames --fps --resume --repeat --spp --time --aov --temporal
+                  --eye-sep --zero-parallax --overlay --composite --frames --fps --resume --repeat --spp --seed --time --aov --temporal
                   --shutter --motion-blur --shutter-samples --shutter-steps --sub-frames
                   $_sy_cluster $_sy_common" ;;
     view) echo "-b -w -h --camera --look-at --orbit --fov --bookmark --bookmarks --clip --clip-cap --hide --isolate --select --overlay --composite --frames --screenshot --filter --threshold --keys --spp --budget --no-temporal

@@ -385,7 +385,7 @@ int sy_cmd_render(int argc, char **argv)
                                  * from the motion (motion_steps_auto) */
     const sy_cli_opt opts[] = {
         SY_CLI_OPT_TEXT(NULL, 'b', &backend), SY_CLI_OPT_TEXT(NULL, 'o', &outp),
-        SY_CLI_OPT_UINT("spp", OPT_SPP, &po.spp, 1, 1u << 24),
+        SY_CLI_OPT_UINT("spp", OPT_SPP, &po.spp, 1, 1u << 24), SY_CLI_OPT_UINT("seed", OPT_SEED, &po.seed, 0, UINT32_MAX),
         SY_CLI_OPT_REAL("time", OPT_TIME, &po.time_budget, DBL_TRUE_MIN, DBL_MAX), SY_CLI_OPT_FLAG("aov", OPT_AOV, &po.aov),
         SY_CLI_OPT_TEXT("camera", OPT_CAMERA, &camera), SY_CLI_OPT_TEXT("params", OPT_PARAMS, &params),
         SY_CLI_OPT_TEXT("gl", OPT_GL, &gl_provider),          /* raster: gl=... parameter */
@@ -700,7 +700,7 @@ int sy_cmd_render(int argc, char **argv)
             sy_context_restart(rc);
     }
     progress_state ps = {shown, sy_time_now(), 0, sy_is_terminal(2) && !seq, false};
-    sy_window_render_opts ro = {.progress = sy_cli_progress_cb, .progress_user = &ps};
+    sy_window_render_opts ro = {.progress = sy_cli_progress_cb, .progress_user = &ps, .seed = po.seed};
     double t0 = sy_time_now();
     sy_context *pctx = NULL;
     char samples_str[32], secs_str[32];

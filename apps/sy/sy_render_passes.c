@@ -368,7 +368,7 @@ sy_result sy_cli_render_blurred(loaded *ld, const char *clip, double frame_time,
         double weight = 1.0;
         if (po) {
             sy_cli_pt_opts pi = *po;
-            pi.seed = i;
+            pi.seed = po->seed + i;
             if (spp) pi.spp = (uint32_t)(spp / n + (i < spp % n ? 1 : 0));
             if (po->time_budget > 0) pi.time_budget = po->time_budget / n;
             restart_main(ld, pool, spec);
@@ -379,7 +379,7 @@ sy_result sy_cli_render_blurred(loaded *ld, const char *clip, double frame_time,
             total += smp;
         } else {
             sy_window_render_opts o = *ro;
-            o.seed = i;
+            o.seed = ro->seed + i;
             r = sy_compose_render(ld->scene, pool, spec, w, h, &o, &sub, &sub_right, err);
             total++;
         }

@@ -21,7 +21,8 @@
 #   - sy bench sync / sy bench anim / sy bench rays / sy bench governor / sy bench limit on small sizes: exit 0 and
 #     their result lines (no thresholds; bench limit: no replayed answer differs from the frame's), a bad --spp named
 #   - sy demo -o DIR -w 64 -h 36: demo_whitted.png / .exr written
-#   - -b pathtracer: --spp with --aov (EXR with feature channels), --time; a non-EXR --env fails
+#   - -b pathtracer: --spp with --aov (EXR with feature channels), --time; --seed (the same twice the same
+#     image, another other noise); a non-EXR --env fails
 #   - -b pathtracer --filter pixel --threshold T and --filter radiance write an image; --filter
 #     bogus, a bad radiance option and a negative threshold fail naming the problem
 #     naming the file
@@ -566,6 +567,14 @@ run pt_spp "$SY" render demo -b pathtracer --spp 2 -w 32 -h 24 --aov -o "$TMP/pt
 [ "$rc" -eq 0 ] && magic "$TMP/pt/pt.exr" 762f3101 && grep -q '2 samples per pixel' "$TMP/pt_spp.out" &&
     grep -aq 'albedo.R' "$TMP/pt/pt.exr" && grep -aq 'indirect.B' "$TMP/pt/pt.exr" ||
     fail "pathtracer --spp 2 --aov: status $rc, $(cat "$TMP/pt_spp.err")"
+# --seed: the same seed twice the same image, another seed other noise (the default is 0)
+if [ -n "$EXR_EQUAL" ]; then
+    run_ok "pathtracer --seed 0" pt_seed0 "$SY" render demo -b pathtracer --spp 1 -w 24 -h 16 -o "$TMP/pt/s0.exr"
+    run_ok "pathtracer --seed 0 given" pt_seed0b "$SY" render demo -b pathtracer --spp 1 -w 24 -h 16 --seed 0 -o "$TMP/pt/s0b.exr"
+    run_ok "pathtracer --seed 7" pt_seed7 "$SY" render demo -b pathtracer --spp 1 -w 24 -h 16 --seed 7 -o "$TMP/pt/s7.exr"
+    exr_same "render --seed 0 differs from the default seed" "$TMP/pt/s0.exr" "$TMP/pt/s0b.exr"
+    exr_differ "render --seed 7 gives the default seed's noise" "$TMP/pt/s0.exr" "$TMP/pt/s7.exr"
+fi
 run pt_time "$SY" render demo -b pathtracer --time 0.3 -w 16 -h 16 --background 0.5,0.5,0.5 -o "$TMP/pt/pt.png"
 [ "$rc" -eq 0 ] && magic "$TMP/pt/pt.png" 89504e47 || fail "pathtracer --time: status $rc, $(cat "$TMP/pt_time.err")"
 expect_error pt_env bad.gltf "$TMP/o_ptenv" "$SY" render demo -b pathtracer --spp 1 -w 8 -h 8 \
