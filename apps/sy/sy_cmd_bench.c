@@ -187,10 +187,10 @@ int sy_cmd_bench(int argc, char **argv)
         if (optind < argc) return sy_cli_usage_of(who, "no SCENE: the animated scenes are generated");
         return sy_bench_anim(tris == 100 ? 100000 : tris, nodes, repeats ? repeats : 50, &err) == SY_OK ? 0 : sy_cli_fail(&err);
     }
-    if (!strcmp(cmd, "lights")) { /* --nodes: emissive quads, --tris: point lights, --repeats: seconds per method */
-        if (optind < argc) return sy_cli_usage_of(who, "no SCENE: the many-lights scene is generated");
+    if (!strcmp(cmd, "lights")) { /* --nodes: emissive quads, --tris: point lights, --repeats: seconds per method;
+                                   * the argument: an existing folder for the scene and the images */
         return sy_bench_lights(nodes, tris == 100 ? 1000 : tris, w == 512 ? 320 : w, h == 512 ? 240 : h,
-                               repeats ? repeats : 20, NULL, &err) == SY_OK ? 0 : sy_cli_fail(&err);
+                               repeats ? repeats : 20, scene, &err) == SY_OK ? 0 : sy_cli_fail(&err);
     }
     if (!strcmp(cmd, "sync")) return sy_bench_sync(nodes, tris, repeats ? repeats : 50, &err) == SY_OK ? 0 : sy_cli_fail(&err);
     if (!strcmp(cmd, "viewports"))

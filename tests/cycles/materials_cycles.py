@@ -5,6 +5,10 @@
 #   blender -b -noaudio --factory-startup -P tests/cycles/materials_cycles.py -- \
 #       --gltf MODEL.gltf --like SY_RENDER.exr --spp 1024 --bounces 8 --env 1,1,1 --out ref.exr
 #
+# --lighting is the importer's conversion of punctual lights (SPEC, Blender's default: candela /
+# 683 as watts per steradian; COMPAT: candela as watts per steradian, sy's convention; RAW).
+# Punctual lights get no size and single-sided materials emit from their front only, as in glTF.
+#
 # --like names an image `sy render` wrote: its header gives the size (sy:size), the camera-to-world
 # matrix (sy:camera_to_world, column-major, glTF's Y-up world) and the projection (sy:projection:
 # "perspective yfov RADIANS" or "orthographic ymag HALF_HEIGHT"); the script reads them with
@@ -27,7 +31,8 @@ from mathutils import Matrix
 
 def parse_args():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-    a = {"gltf": None, "like": None, "spp": 1024, "bounces": 8, "env": "1,1,1", "out": None, "sy": "sy", "seed": 0}
+    a = {"gltf": None, "like": None, "spp": 1024, "bounces": 8, "env": "1,1,1", "out": None, "sy": "sy", "seed": 0,
+         "lighting": "SPEC"}
     i = 0
     while i < len(argv):
         k = argv[i]
@@ -54,6 +59,34 @@ def sy_view(sy, image):
     return w, h, cam, kind, float(value)
 
 
+def punctual_and_one_sided():
+    """What the importer leaves to Blender's defaults, made glTF's (and sy's): punctual lights have
+    no size (a new Blender light is a sphere of radius 0.25), and a single-sided material emits
+    from its front only (Cycles' emission shaders emit from both sides): the emission strength
+    times 1 - Backfacing."""
+    for light in bpy.data.lights:
+        light.shadow_soft_size = 0.0
+    for mat in bpy.data.materials:
+        if not mat.use_nodes or not mat.use_backface_culling:
+            continue
+        nt = mat.node_tree
+        for node in list(nt.nodes):
+            sock = node.inputs.get("Emission Strength") if node.type == "BSDF_PRINCIPLED" else (
+                node.inputs.get("Strength") if node.type == "EMISSION" else None)
+            if sock is None or sock.is_linked or sock.default_value == 0.0:
+                continue
+            geo = nt.nodes.new("ShaderNodeNewGeometry")
+            front = nt.nodes.new("ShaderNodeMath")
+            front.operation = "SUBTRACT"
+            front.inputs[0].default_value = 1.0
+            nt.links.new(geo.outputs["Backfacing"], front.inputs[1])
+            scaled = nt.nodes.new("ShaderNodeMath")
+            scaled.operation = "MULTIPLY"
+            scaled.inputs[0].default_value = sock.default_value
+            nt.links.new(front.outputs[0], scaled.inputs[1])
+            nt.links.new(scaled.outputs[0], sock)
+
+
 def main():
     a = parse_args()
     import numpy  # the 3.4 importer still says numpy.bool (cycles-references.md)
@@ -63,7 +96,8 @@ def main():
     w, h, cam_gltf, kind, value = sy_view(a["sy"], a["like"])
 
     bpy.ops.wm.read_factory_settings(use_empty=True)
-    bpy.ops.import_scene.gltf(filepath=a["gltf"])
+    bpy.ops.import_scene.gltf(filepath=a["gltf"], convert_lighting_mode=a["lighting"].upper())
+    punctual_and_one_sided()
     with open(a["gltf"], "rb") as f:
         head = f.read(4)
     used = []
