@@ -61,7 +61,7 @@ for run in $(seq 1 "$runs"); do
     ec=$("$err" "$out/cycles_$run.exr" "$out/ref_cycles.exr" | awk 'NR == 1 { print $2 }')
     es=$("$err" "$out/sy_$run.exr" "$out/ref_sy.exr" | awk 'NR == 1 { print $2 }')
     line=$(awk -v r="$run" -v tc="$tc" -v ec="$ec" -v ts="$ts" -v es="$es" 'BEGIN {
-        printf "%4d  %9.2f %10.6f %10.6f  %9.2f %10.6f %10.6f  %7.2fx\n", r, tc, ec, tc * ec, ts, es, ts * es,
+        printf "%4d  %9.2f %10.3e %10.3e  %9.2f %10.3e %10.3e  %7.2fx\n", r, tc, ec, tc * ec, ts, es, ts * es,
                (tc * ec) / (ts * es) }')
     echo "$line"
     ratios+=("$(echo "$line" | awk '{ sub("x", "", $NF); print $NF }')")
