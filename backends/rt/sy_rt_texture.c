@@ -97,6 +97,15 @@ static uint32_t wrap_next(int64_t i, uint32_t w, uint32_t n, sy_rt_wrap mode)
 static void fetch(const sy_rt_texture_data *t, uint32_t x, uint32_t y, float out[4])
 {
     size_t base = ((size_t)y * t->width + x) * t->channels;
+    if (t->format != SY_RT_TEXEL_FLOAT32 && t->channels >= 3) { /* RGB(A) 8-bit, the common case: no per-channel tests */
+        const uint8_t *b = (const uint8_t *)t->pixels + base;
+        const float *lut = t->srgb_lut;
+        out[0] = lut ? lut[b[0]] : (float)b[0] * (1.0f / 255.0f);
+        out[1] = lut ? lut[b[1]] : (float)b[1] * (1.0f / 255.0f);
+        out[2] = lut ? lut[b[2]] : (float)b[2] * (1.0f / 255.0f);
+        out[3] = t->channels == 4 ? (float)b[3] * (1.0f / 255.0f) : 1.0f; /* alpha is linear */
+        return;
+    }
     float c[4] = {0.0f, 0.0f, 0.0f, 1.0f};
     for (uint32_t k = 0; k < t->channels; ++k) {
         if (t->format == SY_RT_TEXEL_FLOAT32) {
