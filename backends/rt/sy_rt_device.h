@@ -122,9 +122,7 @@ typedef struct sy_rt_area_tri {
     sy_rt_v3 p0, e1, e2;        /* world position of vertex 0 and edges to vertices 1, 2 */
     sy_rt_v3 normal;            /* unit geometric normal, front side (glTF winding) */
     float area;
-    float lum;                  /* the emission's luminance (or largest channel) per unit area: the
-                                 * factor's, x the texture's mean over the triangle when textured */
-    float pdf_select;           /* selection pdf per unit area: lum (x 2 double-sided) / the total */
+    float pdf_select;           /* sy_rt_area_pdf of its instance: selection pdf per unit area */
     sy_rt_v3 emission;          /* the material's emissive factor (x strength) */
     const sy_rt_instance_data *inst; /* for the emissive texture lookup */
     uint32_t prim;

@@ -63,6 +63,20 @@ uint32_t sy_rt_alias_pick(const sy_rt_device *dev, float u)
     return frac < dev->area_alias_prob[i] ? i : dev->area_alias_idx[i];
 }
 
+float sy_rt_emission_weight(const sy_rt_material_data *mat)
+{
+    float lum = v3_luminance(v3_load(mat->desc.emissive));
+    if (!(lum > 0.0f)) lum = fmaxf(mat->desc.emissive[0], fmaxf(mat->desc.emissive[1], mat->desc.emissive[2]));
+    return lum;
+}
+
+float sy_rt_area_pdf(const sy_rt_device *dev, const sy_rt_instance_data *inst)
+{
+    if (!dev->area_count || !(dev->area_power > 0.0f)) return 0.0f;
+    const sy_rt_material_data *mat = sy_rt_material_lookup(dev, inst->material);
+    return sy_rt_emission_weight(mat) * (mat->desc.double_sided ? 2.0f : 1.0f) / dev->area_power;
+}
+
 /* >>moving emitters (motion blur): an area triangle where its instance and mesh are at a ray's time */
 const sy_rt_area_tri *sy_rt_area_at(const sy_rt_area_tri *t, float time, sy_rt_area_tri *scratch)
 {
@@ -382,7 +396,9 @@ static void area_record(const sy_rt_area_tri *a, sy_rt_lt_light *o)
     o->b.axis[0] = a->normal.x, o->b.axis[1] = a->normal.y, o->b.axis[2] = a->normal.z;
     o->b.theta_o = a->double_sided ? PI_F : 0.0f;
     o->b.theta_e = 0.5f * PI_F;
-    o->b.power = a->lum * a->area;
+    float lum = v3_luminance(a->emission);
+    if (!(lum > 0.0f)) lum = fmaxf(a->emission.x, fmaxf(a->emission.y, a->emission.z));
+    o->b.power = lum * a->area;
 }
 
 static void punctual_record(const sy_rt_punctual *l, sy_rt_lt_light *o)

@@ -55,12 +55,17 @@ float sy_rt_env_sample(const sy_rt_env *env, float u1, float u2, sy_rt_v3 *d, sy
  * the light contributes nothing at p. */
 bool sy_rt_punctual_incident(const sy_rt_punctual *l, sy_rt_v3 p, sy_rt_v3 *wi, sy_rt_v3 *e, float *tmax);
 
+/* Area-measure pdf with which the alias table + uniform point selection picks a point on an
+ * emissive instance (the same value for every point of the instance's non-degenerate triangles). */
+float sy_rt_area_pdf(const sy_rt_device *dev, const sy_rt_instance_data *inst);
 /* Triangle t of the area-light list (the open's placement: ray time 0) as placed at ray time `time`
  * (motion blur): t itself when its instance neither moves nor deforms, or at time 0; else *scratch,
  * t with p0, e1, e2, normal and area where its moving instance (sy_rt_instance_at) and deforming mesh
  * (its two vertex steps around the time, as Embree interpolates them) put it then, and pdf_select
  * per unit area of that triangle (the selection still weighs the open's area; a rigid motion keeps it). */
 const sy_rt_area_tri *sy_rt_area_at(const sy_rt_area_tri *t, float time, sy_rt_area_tri *scratch);
+/* The power proxy of an emissive material (luminance of the factor, or its largest channel). */
+float sy_rt_emission_weight(const sy_rt_material_data *mat);
 
 /* >>light tree glue (sy_rt_lighttree.h): the device's tree over its area triangles (light i) and
  * punctual lights (light area_count + i). */

@@ -91,33 +91,6 @@ static void area_free(sy_rt_device *dev)
     dev->area_map = NULL;
 }
 
-/* The power proxy of an emission: its luminance, or its largest channel when that is not positive. */
-static float emission_lum(sy_rt_v3 e)
-{
-    float lum = v3_luminance(e);
-    return lum > 0.0f ? lum : fmaxf(e.x, fmaxf(e.y, e.z));
-}
-
-/* A textured emitter's emission over triangle t of instance in, for light selection: the mean of
- * the emission at 16 points of the triangle (a 4 x 4 grid of cells, one point each, in barycentric
- * coordinates). A triangle whose texels there are black gets 0 and is left out of the light list:
- * DamagedHelmet's emissive map is black but for a few panels, and its 46,356 triangles all took
- * light samples by area. Light selection only: the emission at a sampled point is the texture's
- * there, and a BSDF ray that hits a left-out triangle counts it at full weight (its selection pdf
- * is 0), so the estimate stays unbiased whatever the mean misses. */
-static float textured_lum(const sy_rt_device *dev, const sy_rt_instance_data *in, uint32_t t)
-{
-    enum { G = 4 };
-    float sum = 0.0f;
-    for (int i = 0; i < G; ++i)
-        for (int j = 0; j < G; ++j) {
-            /* cell (i, j) of a square mapped onto the triangle by u = 1 - sqrt(a), v = b sqrt(a) */
-            float a = ((float)i + 0.5f) / G, b = ((float)j + 0.5f) / G, sa = sqrtf(a);
-            sum += emission_lum(sy_rt_surface_emission(dev, in, t, 1.0f - sa, b * sa));
-        }
-    return sum / (float)(G * G);
-}
-
 static sy_rt_result rebuild_area_lights(sy_rt_device *dev)
 {
     size_t n = 0;
@@ -150,7 +123,8 @@ static sy_rt_result rebuild_area_lights(sy_rt_device *dev)
         if (!in || !sy_rt_instance_emissive(dev, in)) continue;
         in->area_base = base;
         const sy_rt_material_data *mat = sy_rt_material_lookup(dev, in->material);
-        float lum = emission_lum(v3_load(mat->desc.emissive));
+        float lum = v3_luminance(v3_load(mat->desc.emissive));
+        if (!(lum > 0.0f)) lum = fmaxf(mat->desc.emissive[0], fmaxf(mat->desc.emissive[1], mat->desc.emissive[2]));
         const sy_rt_mesh_data *m = in->mesh;
         for (uint32_t t = 0; t < m->triangle_count; ++t) {
             dev->area_map[base + t] = UINT32_MAX;
@@ -176,9 +150,7 @@ static sy_rt_result rebuild_area_lights(sy_rt_device *dev)
             a->double_sided = mat->desc.double_sided;
             a->emission = v3_load(mat->desc.emissive);
             a->textured = mat->desc.emissive_texture.texture.id != 0;
-            a->lum = a->textured ? textured_lum(dev, in, t) : lum;
-            if (!(a->lum > 0.0f)) continue; /* black texels: no light to sample (a hit still shows them) */
-            cdf[count + 1] = cdf[count] + (double)a->lum * a->area * (a->double_sided ? 2.0 : 1.0);
+            cdf[count + 1] = cdf[count] + (double)lum * a->area * (a->double_sided ? 2.0 : 1.0);
             dev->area_map[base + t] = count;
             count++;
         }
@@ -203,8 +175,7 @@ static sy_rt_result rebuild_area_lights(sy_rt_device *dev)
     }
     dev->area_count = count;
     dev->area_power = (float)total;
-    for (uint32_t i = 0; i < count; ++i)
-        dev->area[i].pdf_select = (float)((double)dev->area[i].lum * (dev->area[i].double_sided ? 2.0 : 1.0) / total);
+    for (uint32_t i = 0; i < count; ++i) dev->area[i].pdf_select = sy_rt_area_pdf(dev, dev->area[i].inst);
     return SY_RT_OK;
 }
 

@@ -734,79 +734,6 @@ static void test_area_light_grazing(void)
     sy_rt_device_destroy(dev);
 }
 
-/* Two emissive triangles facing a floor, one mesh; `textured`: one emissive material whose texture
- * (2 x 1 texels, nearest) is white under the first triangle's texture coordinates and black under
- * the second's; else the first triangle emits white and the second is the same surface without
- * emission (two meshes). Renders the floor with the light tree `lt`. */
-static img half_lit_emitter(bool textured, sy_rt_light_tree_mode lt, uint32_t *lights)
-{
-    sy_rt_device *dev = rt_device();
-    /* the triangles at z = -1, wound to face -z (the floor at z = -2) */
-    const float pos[] = {-0.6f, -0.25f, -1, -0.1f, 0.25f, -1, -0.1f, -0.25f, -1,
-                         0.1f, -0.25f, -1, 0.6f, 0.25f, -1, 0.6f, -0.25f, -1};
-    const float uv[] = {0.25f, 0.5f, 0.25f, 0.5f, 0.25f, 0.5f, 0.75f, 0.5f, 0.75f, 0.5f, 0.75f, 0.5f};
-    const uint32_t idx[] = {0, 1, 2, 3, 4, 5};
-    sy_rt_material_desc md;
-    sy_rt_material_desc_init(&md);
-    rt_set3(md.emissive, 3.0f, 3.0f, 3.0f);
-    if (textured) {
-        float texels[6] = {1, 1, 1, 0, 0, 0};
-        sy_rt_texture_desc td = {.width = 2, .height = 1, .channels = 3, .format = SY_RT_TEXEL_FLOAT32, .pixels = texels,
-                                 .wrap_s = SY_RT_WRAP_CLAMP, .wrap_t = SY_RT_WRAP_CLAMP, .filter = SY_RT_FILTER_NEAREST};
-        MUST(sy_rt_texture_create(dev, &td, &md.emissive_texture.texture));
-        sy_rt_mesh_desc d = {.positions = pos, .uv = {uv, NULL}, .indices = idx, .vertex_count = 6, .triangle_count = 2};
-        sy_rt_mesh m;
-        MUST(sy_rt_mesh_create(dev, &d, &m));
-        rt_place(dev, m, NULL, rt_material(dev, &md), 0);
-    } else {
-        sy_rt_material_desc dark = md;
-        rt_set3(dark.emissive, 0.0f, 0.0f, 0.0f);
-        for (int k = 0; k < 2; ++k) {
-            sy_rt_mesh_desc d = {.positions = pos + 9 * k, .indices = idx, .vertex_count = 3, .triangle_count = 1};
-            sy_rt_mesh m;
-            MUST(sy_rt_mesh_create(dev, &d, &m));
-            rt_place(dev, m, NULL, rt_material(dev, k ? &dark : &md), 0);
-        }
-    }
-    float xf[16];
-    rt_translation(xf, 0.0f, 0.0f, -2.0f);
-    rt_place(dev, rt_quad(dev, 3.0f), xf, rt_lambert(dev, 0.7f, 0.7f, 0.7f), 0);
-    MUST(sy_rt_commit(dev));
-    sy_rt_stats st;
-    sy_rt_device_stats(dev, &st);
-    *lights = st.area_light_triangles;
-    sy_rt_camera cam = rt_camera(1.0f, 0.8f);
-    img r = {32, 32, malloc(32 * 32 * 4 * sizeof(float)), malloc(32 * 32 * sizeof(float)), NULL};
-    MUST(sy_rt_accum_create(dev, 32, 32, &r.acc));
-    sy_rt_render_desc d = rt_desc(SY_RT_INTEGRATOR_PATHTRACER, 32, 32);
-    d.accum = r.acc, d.samples = 256, d.seed = 3, d.max_depth = 4, d.light_tree = lt;
-    MUST(sy_rt_render(dev, &cam, &d, r.rgba, r.depth));
-    sy_rt_device_destroy(dev);
-    return r;
-}
-
-/* A textured emitter's light selection weighs each triangle by its texels (the mean of 16 points):
- * a triangle over black texels is no light (DamagedHelmet's emissive map is black but for a few
- * panels); the image is that of the same emitter without the dark triangle's emission, with the
- * alias table and with the light tree (the hits on the left-out triangle count at full weight). */
-static void test_textured_emitter_selection(void)
-{
-    static const sy_rt_light_tree_mode modes[2] = {SY_RT_LIGHT_TREE_OFF, SY_RT_LIGHT_TREE_ON};
-    for (int k = 0; k < 2; ++k) {
-        uint32_t nt = 0, nu = 0;
-        img t = half_lit_emitter(true, modes[k], &nt), u = half_lit_emitter(false, modes[k], &nu);
-        EXPECT_MSG(nt == 1 && nu == 1, "textured emitter: %u light triangles (want 1: the black one left out), untextured %u", nt, nu);
-        double mt[3], mu[3];
-        mean_rgb(&t, false, mt);
-        mean_rgb(&u, false, mu);
-        printf("textured emitter (light tree %s): mean %.5f, untextured %.5f\n", k ? "on" : "off", mt[0], mu[0]);
-        EXPECT_MSG(mu[0] > 0.001 && rt_near(mt[0], mu[0], 0.03), "textured emitter (light tree %s): mean %.5f, the same emitter untextured %.5f",
-                   k ? "on" : "off", mt[0], mu[0]);
-        img_free(&t);
-        img_free(&u);
-    }
-}
-
 int main(void)
 {
     test_furnaces();
@@ -820,6 +747,5 @@ int main(void)
     test_area_light_grazing();
     test_determinism_and_tiles();
     test_degenerate();
-    test_textured_emitter_selection();
     return sy_check_finish("rt_pathtracer");
 }
