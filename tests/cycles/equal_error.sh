@@ -64,28 +64,8 @@ if [ -n "$model" ]; then
             { echo "equal_error.sh: error: Blender failed, see $4" >&2; exit 1; }
         sed -n 's/^ *Time: \([0-9]*\):\([0-9.]*\).*/\1 \2/p' "$4" | tail -1 | awk '{ printf "%.3f", $1 * 60 + $2 }'
     }
-    # the references with seed 0, the runs with seeds 1..: no run shares its reference's first samples
-    # (with one seed for both, sy's error came out about 12 % low at 16 / 256 spp)
-    [ -s "$out/ref_sy.exr" ] || sy_model "$ref_spp" 0 "$out/ref_sy.exr" "$out/ref_sy.log" >/dev/null
-    [ -s "$out/ref_cycles.exr" ] || cycles_model "$ref_spp" 0 "$out/ref_cycles.exr" "$out/ref_cycles.log" >/dev/null
     echo "$model 256x192, $spp spp, white environment, 8 bounces, $(nproc) threads; each against its own $ref_spp-spp reference"
-    printf '%4s  %9s %10s %10s  %9s %10s %10s  %8s\n' run "Cycles s" relMSE "s x relMSE" "sy s" relMSE "s x relMSE" "speed-up"
-    ratios=()
-    for run in $(seq 1 "$runs"); do
-        tc=$(cycles_model "$spp" "$run" "$out/cycles_$run.exr" "$out/cycles_$run.log")
-        ts=$(sy_model "$spp" "$run" "$out/sy_$run.exr" "$out/sy_$run.log")
-        ec=$("$err" "$out/cycles_$run.exr" "$out/ref_cycles.exr" | awk 'NR == 1 { print $2 }')
-        es=$("$err" "$out/sy_$run.exr" "$out/ref_sy.exr" | awk 'NR == 1 { print $2 }')
-        line=$(awk -v r="$run" -v tc="$tc" -v ec="$ec" -v ts="$ts" -v es="$es" 'BEGIN {
-            printf "%4d  %9.2f %10.3e %10.3e  %9.2f %10.3e %10.3e  %7.2fx\n", r, tc, ec, tc * ec, ts, es, ts * es,
-                   (tc * ec) / (ts * es) }')
-        echo "$line"
-        ratios+=("$(echo "$line" | awk '{ sub("x", "", $8); print $8 }')")
-    done
-    echo "references: the means of ours over Cycles' (what the importer's materials change): $("$err" "$out/ref_sy.exr" "$out/ref_cycles.exr" | awk 'NR == 1 { print $8 }')"
-    printf '%s\n' "${ratios[@]}" | sort -g | awk '{ v[NR] = $1 } END {
-        m = NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2
-        printf "equal-error speed-up over Cycles: median %.2fx (min %.2fx, max %.2fx) over %d runs\n", m, v[1], v[NR], NR }'
+    equal_error_own_refs "$spp" "$spp" "$ref_spp" "$runs" "$out" cycles_model sy_model
     exit 0
 fi
 

@@ -48,24 +48,5 @@ cycles_run() { # SPP SEED OUT.exr LOG: prints the render's seconds
         --sy "$sy" >"$4" 2>&1 || { echo "lights_equal_error.sh: error: Blender failed, see $4" >&2; exit 1; }
     sed -n 's/^ *Time: \([0-9]*\):\([0-9.]*\).*/\1 \2/p' "$4" | tail -1 | awk '{ printf "%.3f", $1 * 60 + $2 }'
 }
-# the references with seed 0, the runs with seeds 1..: no run shares the samples of its reference
-[ -s "$out/ref_sy.exr" ] || sy_run "$ref_spp" 0 "$out/ref_sy.exr" "$out/ref_sy.log" >/dev/null
-[ -s "$out/ref_cycles.exr" ] || cycles_run "$ref_spp" 0 "$out/ref_cycles.exr" "$out/ref_cycles.log" >/dev/null
-echo "many lights ($gltf) 320x240, 8 bounces, sy $spp spp, Cycles $cspp spp, $(nproc) threads; each against its own $ref_spp-spp reference"
-"$err" "$out/ref_cycles.exr" "$out/ref_sy.exr" | awk 'NR == 1 { print "references: the mean of Cycles\047 over sy\047s", $8, "(relMSE between them", $2 ")" }'
-printf '%4s  %9s %10s %10s  %9s %10s %10s  %8s\n' run "Cycles s" relMSE "s x relMSE" "sy s" relMSE "s x relMSE" "speed-up"
-ratios=()
-for run in $(seq 1 "$runs"); do
-    tc=$(cycles_run "$cspp" "$run" "$out/cycles_$run.exr" "$out/cycles_$run.log")
-    ts=$(sy_run "$spp" "$run" "$out/sy_$run.exr" "$out/sy_$run.log")
-    ec=$("$err" "$out/cycles_$run.exr" "$out/ref_cycles.exr" | awk 'NR == 1 { print $2 }')
-    es=$("$err" "$out/sy_$run.exr" "$out/ref_sy.exr" | awk 'NR == 1 { print $2 }')
-    line=$(awk -v r="$run" -v tc="$tc" -v ec="$ec" -v ts="$ts" -v es="$es" 'BEGIN {
-        printf "%4d  %9.2f %10.3e %10.3e  %9.2f %10.3e %10.3e  %7.2fx\n", r, tc, ec, tc * ec, ts, es, ts * es,
-               (tc * ec) / (ts * es) }')
-    echo "$line"
-    ratios+=("$(echo "$line" | awk '{ sub("x", "", $NF); print $NF }')")
-done
-printf '%s\n' "${ratios[@]}" | sort -g | awk '{ v[NR] = $1 } END {
-    m = NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2
-    printf "speed-up at equal error: median %.2fx (min %.2fx, max %.2fx) over %d runs (target >= 10x)\n", m, v[1], v[NR], NR }'
+echo "many lights ($gltf) 320x240, 8 bounces, sy $spp spp, Cycles $cspp spp, $(nproc) threads; each against its own $ref_spp-spp reference (target >= 10x)"
+equal_error_own_refs "$spp" "$cspp" "$ref_spp" "$runs" "$out" cycles_run sy_run
