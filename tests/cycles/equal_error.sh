@@ -44,11 +44,7 @@ if [ -n "$model" ]; then
 fi
 skip_without_blender
 skip_without "$gltf" "$ref"
-sy=$build/apps/sy/sy
-err=$build/tests/exr_error
-for tool in "$sy" "$err"; do
-    [ -x "$tool" ] || { echo "equal_error.sh: error: $tool is missing (build first: cmake --build $build)" >&2; exit 1; }
-done
+need_sy_tools # sy, err
 mkdir -p "$out"
 
 if [ -n "$model" ]; then

@@ -27,11 +27,7 @@ runs=${4:-3}
 ref_spp=${REF_SPP:-256}
 cspp=${CYCLES_SPP:-$spp}
 skip_without_blender
-sy=$build/apps/sy/sy
-err=$build/tests/exr_error
-for tool in "$sy" "$err"; do
-    [ -x "$tool" ] || { echo "lights_equal_error.sh: error: $tool is missing (build first: cmake --build $build)" >&2; exit 1; }
-done
+need_sy_tools # sy, err
 mkdir -p "$out"
 gltf=$out/many_lights.gltf
 [ -s "$gltf" ] || "$sy" bench lights "$out" --repeats 1 >"$out/bench.log" 2>&1 ||

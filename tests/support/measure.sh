@@ -1,7 +1,8 @@
 # measure.sh — the start of the measurement scripts outside ctest (tests/cycles, tests/look;
 # sourced, bash; their first argument is BUILD_DIR): `root`, the checkout; `build`, the build folder
 # (absolute; BUILD_DIR, default root/build; the script ends with status 1 when it is not a folder);
-# `equal_error_own_refs` (below) the comparison with Cycles against each renderer's own reference;
+# `need_sy_tools` (sy, err) and `equal_error_own_refs` (below: the comparison with Cycles against each
+# renderer's own reference);
 # `skip_without_blender [PACKAGES]` and
 # `skip_without PATH...` end the script with status 0 and the reason ("NAME: skipped: ...", NAME the
 # script's file name) when Blender (Debian's PACKAGES, default blender) or one of the paths (the
@@ -17,6 +18,17 @@ skip_without() {
     local p
     for p in "$@"; do
         [ -e "$p" ] || { echo "$(basename "$0"): skipped: $p is absent"; exit 0; }
+    done
+}
+
+# need_sy_tools: sets `sy` (BUILD_DIR/apps/sy/sy) and `err` (BUILD_DIR/tests/exr_error); ends the
+# script with status 1 when either is missing (not built).
+need_sy_tools() {
+    sy=$build/apps/sy/sy
+    err=$build/tests/exr_error
+    local tool
+    for tool in "$sy" "$err"; do
+        [ -x "$tool" ] || { echo "$(basename "$0"): error: $tool is missing (build first: cmake --build $build)" >&2; exit 1; }
     done
 }
 
