@@ -6,7 +6,9 @@
 #       --gltf MODEL.gltf --like SY_RENDER.exr --spp 1024 --bounces 8 --env 1,1,1 --out ref.exr
 #
 # --lighting is the importer's conversion of punctual lights (SPEC, Blender's default: candela /
-# 683 as watts per steradian; COMPAT: candela as watts per steradian, sy's convention; RAW).
+# 683 x 4 pi as watts; COMPAT: candela x 4 pi as watts; RAW: candela as watts). RAW matches sy's
+# lights (LightsPunctualLamp under a white environment: sy's mean 1.03 of Cycles'; SPEC 4.26,
+# COMPAT 0.10).
 # Punctual lights get no size and single-sided materials emit from their front only, as in glTF.
 #
 # --like names an image `sy render` wrote: its header gives the size (sy:size), the camera-to-world
