@@ -7,7 +7,7 @@
 # 8 bounces: `sy render -b pathtracer --filter none --params max_depth=8` (light_tree=auto: the
 # tree) at SPP, Cycles through Blender's glTF importer from sy's view
 # (tests/cycles/materials_cycles.py: black world, punctual lights without size, single-sided
-# emitters emitting from their front only, punctual lights as bright as sy's: --lighting RAW) at
+# emitters emitting from their front only, punctual lights as bright as sy's: --lighting COMPAT) at
 # CYCLES_SPP (default SPP), alternately RUNS times. Each image's relMSE is
 # against its own renderer's REF_SPP-sample reference (default 256, made once in OUT_DIR: the
 # importer's materials are close to ours, not the same), so time x relMSE is each renderer's cost
@@ -40,7 +40,7 @@ sy_run() { # SPP SEED OUT.exr LOG: prints the render's seconds
 }
 cycles_run() { # SPP SEED OUT.exr LOG: prints the render's seconds
     blender -b -noaudio --factory-startup -P "$root/tests/cycles/materials_cycles.py" -- --gltf "$gltf" \
-        --like "$out/ref_sy.exr" --spp "$1" --bounces 8 --env 0,0,0 --lighting RAW --seed "$2" --out "$3" \
+        --like "$out/ref_sy.exr" --spp "$1" --bounces 8 --env 0,0,0 --lighting COMPAT --seed "$2" --out "$3" \
         --sy "$sy" >"$4" 2>&1 || { echo "lights_equal_error.sh: error: Blender failed, see $4" >&2; exit 1; }
     sed -n 's/^ *Time: \([0-9]*\):\([0-9.]*\).*/\1 \2/p' "$4" | tail -1 | awk '{ printf "%.3f", $1 * 60 + $2 }'
 }

@@ -4,9 +4,8 @@
 # rasterizer, all under a uniform white environment the camera does not see (--env-color 1,1,1
 # --env-hidden: transparent where nothing is hit); then Cycles through Blender's own glTF importer,
 # same view (tests/cycles/materials_cycles.py reads the camera from the path tracer's image), same
-# environment, same samples and bounce limit, punctual lights as bright as sy's (--lighting RAW:
-# Blender's default SPEC made LightsPunctualLamp's lights 1/683 as bright, COMPAT 4 pi times too
-# bright; RAW brings its mean within 3 % of sy's). Prints one row per model: the path tracer's mean RGB
+# environment, same samples and bounce limit, punctual lights as bright as sy's (--lighting COMPAT;
+# see materials_cycles.py). Prints one row per model: the path tracer's mean RGB
 # over Cycles' and its relMSE against Cycles (exr_error), Whitted's and the rasterizer's mean over
 # the path tracer's, and the extensions the file uses that Blender's importer ignores (those rows
 # compare a different material; look at the contact sheets instead).
@@ -39,7 +38,7 @@ for m in "${models[@]}"; do
     "$sy" -q render "$f" -b whitted -w "$w" -h "$h" "${world[@]}" -o "$o.whitted.exr" >/dev/null
     "$sy" -q render "$f" -b raster -w "$w" -h "$h" "${world[@]}" -o "$o.raster.exr" >/dev/null
     log=$(blender -b -noaudio --factory-startup -P "$root/tests/cycles/materials_cycles.py" -- --gltf "$f" \
-        --like "$o.pathtracer.exr" --spp "$spp" --bounces 8 --env 1,1,1 --lighting RAW --out "$o.cycles.exr" \
+        --like "$o.pathtracer.exr" --spp "$spp" --bounces 8 --env 1,1,1 --lighting COMPAT --out "$o.cycles.exr" \
         --sy "$sy" 2>&1) ||
         { echo "$m: Blender failed:"; echo "$log" | tail -5; continue; }
     ignored=$(echo "$log" | sed -n 's/^ignored-extensions: //p')

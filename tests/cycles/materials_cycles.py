@@ -6,9 +6,11 @@
 #       --gltf MODEL.gltf --like SY_RENDER.exr --spp 1024 --bounces 8 --env 1,1,1 --out ref.exr
 #
 # --lighting is the importer's conversion of punctual lights (SPEC, Blender's default: candela /
-# 683 x 4 pi as watts; COMPAT: candela x 4 pi as watts; RAW: candela as watts). RAW matches sy's
-# lights (LightsPunctualLamp under a white environment: sy's mean 1.03 of Cycles'; SPEC 4.26,
-# COMPAT 0.10).
+# 683 x 4 pi as watts; COMPAT: candela x 4 pi as watts; RAW: candela as watts). COMPAT matches
+# sy's lights: 12 point lights over a grey floor (`sy bench lights DIR --nodes 1 --tris 12`) came out
+# with sy's mean 0.90 of Cycles' with COMPAT, 11.3 with RAW (the rest: the importer's materials).
+# LightsPunctualLamp cannot tell: its lights sit in glass, which sy's shadow rays to punctual lights
+# pass and Cycles' do not.
 # Punctual lights get no size and single-sided materials emit from their front only, as in glTF.
 #
 # --like names an image `sy render` wrote: its header gives the size (sy:size), the camera-to-world
