@@ -242,9 +242,10 @@ static sy_rt_v3 dominant_dir(sy_rt_v3 n, sy_rt_v3 wo, float alpha)
     return v3_normalize(v3_add(v3_scale(n, 1.0f - f), v3_scale(r, f)));
 }
 
-/* The model of BSDF b, its albedos (amodel_matrices adds the lobes' transforms); false when it has
+/* The model of BSDF b, its albedos (amodel_matrices adds the lobes' transforms; env: the lobes'
+ * directions into the prefiltered environment too); false when it has
  * lobes the model does not describe (iridescence, anisotropy): those keep the sampled estimates. */
-static bool amodel_init(amodel *m, const sy_rt_bsdf *b, sy_rt_v3 wo)
+static bool amodel_init(amodel *m, const sy_rt_bsdf *b, sy_rt_v3 wo, bool env)
 {
     if (b->irid > 0.0f || b->aniso) return false;
     pthread_once(&g_ltc_once, ltc_load);
@@ -263,7 +264,7 @@ static bool amodel_init(amodel *m, const sy_rt_bsdf *b, sy_rt_v3 wo)
     float fdm = sy_rt_minf(sy_rt_maxf(fd.x, sy_rt_maxf(fd.y, fd.z)), 1.0f);
     m->kd = v3_scale(b->base, b->w_diel * (1.0f - fdm));
     if (b->q_sheen > 0.0f) m->kd = v3_add(m->kd, v3_scale(b->sheen, sy_rt_sheen_albedo(nv, b->sheen_r)));
-    m->r_dir = dominant_dir(b->n, wo, b->alpha);
+    m->r_dir = env ? dominant_dir(b->n, wo, b->alpha) : b->n; /* read only by the environment's split sum */
     m->fc = 0.0f, m->rough_c = 0.0f, m->nc = b->n, m->rc_dir = m->r_dir;
     if (b->cc > 0.0f && !b->cc_delta && b->q_coat > 0.0f) {
         m->nc = b->cc_n ? b->ncc : b->n;
@@ -271,7 +272,7 @@ static bool amodel_init(amodel *m, const sy_rt_bsdf *b, sy_rt_v3 wo)
         m->rough_c = sqrtf(b->cc_alpha);
         ggx_albedo(m->nc, wo, m->rough_c, tc);
         m->fc = b->cc * (0.04f * tc[0] + 0.96f * tc[1]);
-        m->rc_dir = dominant_dir(m->nc, wo, b->cc_alpha);
+        if (env) m->rc_dir = dominant_dir(m->nc, wo, b->cc_alpha);
     }
     return true;
 }
@@ -406,12 +407,12 @@ static inline float edge_factor(float x)
  * diffuse lobe) they stay in world space and z is along n. Per polygon: fz the form factor's z,
  * flen its length, above 1 where every vertex is above the horizon (then max(fz, 0) is the
  * integral; else lobe_value clips through ltc2's sphere term), below 1 where none is. */
-SY_WHITTED_CLONES
-static void lobe_forms(const apoly_soa *restrict q, uint32_t n, float px, float py, float pz, const float *m,
-                       float nx, float ny, float nz, float *restrict fz, float *restrict flen,
-                       float *restrict above, float *restrict below)
+static inline __attribute__((always_inline)) void
+lobe_forms_body(const apoly_soa *restrict q, uint32_t n, float px, float py, float pz, const float *m, float nx,
+                float ny, float nz, float *restrict fz, float *restrict flen, float *restrict above,
+                float *restrict below, const bool world)
 {
-    const bool world = m == NULL; /* a select per lane below, not a branch: the loop stays vectorisable */
+    /* world is a constant in each caller below: the other case's arithmetic folds away */
     float m0 = world ? 1.0f : m[0], m1 = world ? 0.0f : m[1], m2 = world ? 0.0f : m[2];
     float m3 = world ? 0.0f : m[3], m4 = world ? 1.0f : m[4], m5 = world ? 0.0f : m[5];
     float m6 = world ? 0.0f : m[6], m7 = world ? 0.0f : m[7], m8 = world ? 1.0f : m[8];
@@ -445,6 +446,22 @@ static void lobe_forms(const apoly_soa *restrict q, uint32_t n, float px, float 
         flen[i] = sqrtf(fx * fx + fy * fy + fzz * fzz);
         above[i] = up, below[i] = down;
     }
+}
+
+/* lobe_forms_body without a transform (the diffuse lobe, in world space along n) and with one */
+SY_WHITTED_CLONES
+static void lobe_forms_world(const apoly_soa *restrict q, uint32_t n, float px, float py, float pz, float nx, float ny,
+                             float nz, float *restrict fz, float *restrict flen, float *restrict above,
+                             float *restrict below)
+{
+    lobe_forms_body(q, n, px, py, pz, NULL, nx, ny, nz, fz, flen, above, below, true);
+}
+
+SY_WHITTED_CLONES
+static void lobe_forms(const apoly_soa *restrict q, uint32_t n, float px, float py, float pz, const float *m,
+                       float *restrict fz, float *restrict flen, float *restrict above, float *restrict below)
+{
+    lobe_forms_body(q, n, px, py, pz, m, 0.0f, 0.0f, 0.0f, fz, flen, above, below, false);
 }
 
 /* Whether polygon i lights the shading point (px, py, pz) at all: not in its plane, and on its
@@ -501,9 +518,9 @@ static void area_unshadowed_all(amodel *m, const apoly_soa *q, uint32_t n, sy_rt
         pk.quad[j] = pk.quad[np - 1u];
     }
     if (spec || coat) amodel_matrices(m);
-    lobe_forms(&pk, nv, x.x, x.y, x.z, NULL, nn.x, nn.y, nn.z, fz[0], len[0], above[0], below);
-    if (spec) lobe_forms(&pk, nv, x.x, x.y, x.z, m->minv, 0.0f, 0.0f, 0.0f, fz[1], len[1], above[1], unused);
-    if (coat) lobe_forms(&pk, nv, x.x, x.y, x.z, m->minv_c, 0.0f, 0.0f, 0.0f, fz[2], len[2], above[2], unused);
+    lobe_forms_world(&pk, nv, x.x, x.y, x.z, nn.x, nn.y, nn.z, fz[0], len[0], above[0], below);
+    if (spec) lobe_forms(&pk, nv, x.x, x.y, x.z, m->minv, fz[1], len[1], above[1], unused);
+    if (coat) lobe_forms(&pk, nv, x.x, x.y, x.z, m->minv_c, fz[2], len[2], above[2], unused);
     for (uint32_t j = 0; j < np; ++j) {
         if (below[j] > 0.0f) continue;
         uint32_t i = idx[j];
@@ -594,14 +611,19 @@ SY_WHITTED_COLD static sy_rt_v3 direct_area(trace_ctx *c, const sy_rt_surface *s
     return v3_scale(sum, 1.0f / (float)n);
 }
 
-/* Triangle t's solid angle seen from x, approximated at its centroid (area x cos / d^2): what a
- * quad's two triangles share of its samples (only the samples' density: p_sel keeps them
- * unbiased; the exact form, Van Oosterom and Strackee's, cost 7 % of a render with atan2f). */
-static float tri_solid_angle_approx(const sy_rt_area_tri *t, sy_rt_v3 x)
+/* The share of a quad's samples that its first triangle t0 takes (t1 the second): their solid
+ * angles seen from x approximated at their centroids, area x cos / d^2 (the cosine is the same for
+ * both: they are coplanar, so area / d^3 compares them), or `fallback` (their areas' share) where
+ * that says nothing. Only the samples' density: the selection probability keeps them unbiased (the
+ * exact form, Van Oosterom and Strackee's, cost 7 % of a render with atan2f). */
+static float quad_split(const sy_rt_area_tri *t0, const sy_rt_area_tri *t1, sy_rt_v3 x, float fallback)
 {
-    sy_rt_v3 v = v3_sub(v3_add(t->p0, v3_scale(v3_add(t->e1, t->e2), 1.0f / 3.0f)), x);
-    float d2 = v3_dot(v, v), o = t->area * fabsf(v3_dot(t->normal, v)) / (d2 * sqrtf(d2));
-    return isfinite(o) && o > 0.0f ? o : 0.0f;
+    sy_rt_v3 v0 = v3_sub(v3_add(t0->p0, v3_scale(v3_add(t0->e1, t0->e2), 1.0f / 3.0f)), x);
+    sy_rt_v3 v1 = v3_sub(v3_add(t1->p0, v3_scale(v3_add(t1->e1, t1->e2), 1.0f / 3.0f)), x);
+    float d0 = v3_dot(v0, v0), d1 = v3_dot(v1, v1);
+    float w0 = t0->area * d1 * sqrtf(d1), w1 = t1->area * d0 * sqrtf(d0); /* a0 / d0^3 : a1 / d1^3, cross-multiplied */
+    float split = w0 / (w0 + w1);
+    return isfinite(split) && w0 + w1 > 0.0f ? split : fallback;
 }
 
 static sy_rt_v3 gram_schmidt(sy_rt_v3 v, sy_rt_v3 w) { return v3_sub(v, v3_scale(w, v3_dot(v, w))); }
@@ -724,8 +746,7 @@ static sy_rt_v3 direct_area_analytic(trace_ctx *c, const sy_rt_surface *s, const
         float w_dir; /* 1 / the direction's pdf (solid angle) */
         if (pg->nv == 4u) {
             const sy_rt_area_tri *t1 = &dev->area[pg->tri[1]];
-            float o0 = tri_solid_angle_approx(t, s->p), o1 = tri_solid_angle_approx(t1, s->p);
-            float split = o0 + o1 > 0.0f ? o0 / (o0 + o1) : pg->split;
+            float split = quad_split(t, t1, s->p, pg->split);
             if (ut < split) p_sel *= split;
             else t = t1, p_sel *= 1.0f - split;
         }
@@ -924,7 +945,7 @@ static rgba_t shade(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 d, uint32_t d
         if (sy_rt_bsdf_evaluable(&b)) {
             L = c->job->lt ? direct_tree(c, s, &b, p_out, wo, depth) : direct_punctual(c, s, &b, p_out, wo);
             amodel am;
-            bool model = (c->job->area_analytic || c->job->env.filter) && amodel_init(&am, &b, wo);
+            bool model = (c->job->area_analytic || c->job->env.filter) && amodel_init(&am, &b, wo, c->job->env.filter != NULL);
             if (model && depth == 0u && c->cur) c->cur->inst = s->inst, c->cur->n = b.n, c->cur->w = 1.0f;
             if (c->dev->area_count && !c->job->lt)
                 L = v3_add(L, model && c->job->area_analytic ? direct_area_analytic(c, s, &b, &am, p_out, wo, depth)
