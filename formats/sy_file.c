@@ -65,17 +65,19 @@ sy_result sy_file_read_all(const char *path, size_t max_bytes, void **data_out, 
 
     for (;;) {
         if (len == cap) {
-            /* The file grew past its stat size or is not a regular file: grow up to the limit. */
+            /* Full: one more byte tells the end of the file (a regular file's stat size read whole:
+             * no growth, the buffer stays the file's size; doubling it first took twice a large
+             * file's bytes) from a file that grew past its stat size or is not a regular file, which
+             * grows up to the limit ("exactly at the limit" is no error). */
+            unsigned char probe;
+            ssize_t n = read(fd, &probe, 1);
+            if (n < 0 && errno == EINTR) continue;
+            if (n < 0) {
+                rc = sy_error_set(err, SY_ERR_IO, "%s: read failed: %s", path, strerror(errno));
+                goto fail;
+            }
+            if (n == 0) break;
             if (cap >= max_bytes) {
-                /* Probe one more byte to tell "exactly at the limit" from "over the limit". */
-                unsigned char probe;
-                ssize_t n = read(fd, &probe, 1);
-                if (n < 0 && errno == EINTR) continue;
-                if (n < 0) {
-                    rc = sy_error_set(err, SY_ERR_IO, "%s: read failed: %s", path, strerror(errno));
-                    goto fail;
-                }
-                if (n == 0) break;
                 rc = sy_error_set(err, SY_ERR_LIMIT, "%s: file is larger than the limit of %zu bytes", path,
                                   max_bytes);
                 goto fail;
@@ -89,6 +91,8 @@ sy_result sy_file_read_all(const char *path, size_t max_bytes, void **data_out, 
             }
             buf = nbuf;
             cap = ncap;
+            buf[len++] = probe;
+            continue;
         }
         ssize_t n = read(fd, buf + len, cap - len);
         if (n < 0 && errno == EINTR) continue;

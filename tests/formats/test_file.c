@@ -3,6 +3,8 @@
 
 #include "test_util.h"
 
+#include <malloc.h>
+
 static void test_read_all(const char *dir)
 {
     char p[4096];
@@ -18,6 +20,21 @@ static void test_read_all(const char *dir)
     EXPECT_MSG(data && memcmp(data, content, sizeof content) == 0, "content differs");
     EXPECT_MSG(data && ((const char *)data)[n] == '\0', "not NUL-terminated");
     free(data);
+
+    /* A regular file is read into a buffer of its size (+ 1 for the NUL): the buffer was doubled
+     * to look for more bytes after the stat size, so a 300 MB file took 600 MB of memory. */
+    {
+        char bp[4096];
+        PATHF(bp, "%s/big.bin", dir);
+        enum { BIG = 300000 };
+        char *big = calloc(BIG, 1);
+        EXPECT_MSG(big && write_bytes(bp, big, BIG) == 0, "cannot write %s", bp);
+        free(big);
+        EXPECT_MSG(sy_file_read_all(bp, 1 << 20, &data, &n, &err) == SY_OK && n == BIG, "%s", err.message);
+        EXPECT_MSG(data && malloc_usable_size(data) < BIG + BIG / 2, "a %d-byte file took a %zu-byte buffer", BIG,
+                   data ? malloc_usable_size(data) : 0);
+        free(data);
+    }
 
     /* Exactly at the limit is fine; one byte below is refused with SY_ERR_LIMIT, naming the file. */
     EXPECT_MSG(sy_file_read_all(p, sizeof content, &data, &n, &err) == SY_OK, "%s", err.message);
