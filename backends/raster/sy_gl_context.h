@@ -51,7 +51,9 @@
     X(PFNGLGENRENDERBUFFERSPROC, GenRenderbuffers) X(PFNGLDELETERENDERBUFFERSPROC, DeleteRenderbuffers)          \
     X(PFNGLBINDRENDERBUFFERPROC, BindRenderbuffer)                                                                \
     X(PFNGLRENDERBUFFERSTORAGEMULTISAMPLEPROC, RenderbufferStorageMultisample)                                    \
-    X(PFNGLFRAMEBUFFERRENDERBUFFERPROC, FramebufferRenderbuffer)
+    X(PFNGLFRAMEBUFFERRENDERBUFFERPROC, FramebufferRenderbuffer)                                                  \
+    X(PFNGLFENCESYNCPROC, FenceSync) X(PFNGLCLIENTWAITSYNCPROC, ClientWaitSync) X(PFNGLDELETESYNCPROC, DeleteSync) \
+    X(PFNGLGETBUFFERSUBDATAPROC, GetBufferSubData)
 
 typedef struct sy_gl_fns {
 #define SY_GL_MEMBER(type, name) type name;

@@ -44,6 +44,8 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     sy_gli_profile_mark(dev, true, prof);
     snprintf(dev->info, sizeof dev->info, "OpenGL %s on %s (%s)", (const char *)gl->GetString(GL_VERSION),
              (const char *)gl->GetString(GL_RENDERER), sy_gl_provider_name(dd.provider));
+    const char *renderer = (const char *)gl->GetString(GL_RENDERER);
+    dev->throttle = renderer && (strstr(renderer, "llvmpipe") || strstr(renderer, "softpipe")); /* sy_gl_lod.c */
     GLint max_samples = 1, max_tex = 2048;
     gl->GetIntegerv(GL_MAX_SAMPLES, &max_samples);
     gl->GetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
@@ -181,6 +183,7 @@ void sy_gl_device_destroy(sy_gl_device *dev)
             mat_o *m = sy_gli_pool_at(&dev->materials, i);
             if (m->h.id) gl->DeleteBuffers(1, &m->ubo);
         }
+        sy_gli_throttle_free(dev);
         sy_gli_targets_free(dev, &dev->t);
         sy_gli_pick_free(dev);
         if (dev->cap.prog) gl->DeleteProgram(dev->cap.prog);

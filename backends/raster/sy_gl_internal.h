@@ -108,6 +108,10 @@ static inline void *sy_gli_pool_at(const pool *p, uint32_t i) { return (char *)p
 #define LOD_MAX 12
 #define LOD_CACHE_ENTRIES 8u          /* sy_gl_device.lod_cache */
 #define LOD_CACHE_MAX_TRIANGLES (1u << 18) /* meshes above it are not kept (their levels' indices) */
+/* A software rasterizer's queue of binned triangles (sy_gl_lod.c, throttle): a fence after every
+ * THROTTLE_TRIANGLES drawn, at most THROTTLE_FENCES of them pending */
+#define THROTTLE_TRIANGLES (1u << 16)
+#define THROTTLE_FENCES 2u
 
 typedef struct mesh_o {
     slot_head h;
@@ -126,10 +130,14 @@ typedef struct mesh_o {
      * way, 0 not closed or not checked (over CLOSED_MAX_TRIANGLES); see cull_hidden_faces */
     int8_t lod_closed[LOD_MAX];
     int8_t cap_closed; /* sy_gl_mesh_desc.closed: 1, -1 a closed surface section caps fill (its winding), 0 not */
-    /* a mesh with levels of at least LOD_REORDER_VERTICES vertices: the vertex buffer holds the
-     * coarsest level's vertices first, then the next level's new ones, ...: order[i] = the mesh
-     * vertex at buffer position i (malloc'd, freed with the mesh); NULL = the mesh's order */
+    /* a mesh with levels of at least LOD_REORDER_VERTICES vertices (reordered): the vertex buffer
+     * holds the coarsest level's vertices first, then the next level's new ones, ...: order[i] =
+     * the mesh vertex at buffer position i (malloc'd, freed with the mesh). Kept only for meshes
+     * that are updated: made for the upload, freed after it, made again from the index buffer by
+     * the first sy_gl_mesh_update (issue 39: 2 bytes per triangle of a large static mesh). NULL
+     * and not reordered: the mesh's order. */
     uint32_t *order;
+    bool reordered;
 } mesh_o;
 /* Meshes with levels and at least this many vertices get the vertex order above: llvmpipe shades
  * every vertex between a draw's smallest and largest index, so a far level of 10^3 triangles of a
@@ -328,6 +336,12 @@ struct sy_gl_device {
     sy_gl_upload_counts counts, frame, mark;
     uint32_t shadow_maps;
     uint64_t tris, draws;
+    /* sy_gl_lod.c, throttle: on a software rasterizer, the draws' triangles since the last fence and
+     * a ring of THROTTLE_FENCES fences (0: none) */
+    bool throttle;
+    uint64_t throttle_tris;
+    GLsync fences[THROTTLE_FENCES];
+    uint32_t fence_next;
     float lod_pixels;    /* sy_gl_set_lod */
     uint64_t culled;     /* instances outside the view in the last main pass */
     float *scratch;
@@ -495,6 +509,7 @@ sy_gl_result sy_gli_cube_mipmaps(sy_gl_device *dev, GLuint cube, GLuint fbo, uin
 
 /* sy_gl_lod.c */
 uint32_t sy_gli_draw_mesh_lod(sy_gl_device *dev, const mesh_o *m, uint32_t lod);
+void sy_gli_throttle_free(sy_gl_device *dev); /* the throttle's fences deleted (its context current) */
 /* The deviation of a level of detail from its mesh as measured (level: its tris triangles'
  * indices into d's vertices; bmin, bmax d's box; tol: the positional deviation meshoptimizer
  * reports): a length in object space that levels are chosen by (sy_gli_choose_lod). At the

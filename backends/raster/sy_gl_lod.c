@@ -8,7 +8,41 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Draws level `lod` of the mesh (0 or out of range = the mesh itself); returns the triangles drawn. */
+/* The throttle (issue 39, memory on the user's path). llvmpipe bins the triangles of the draws into
+ * scenes that its threads rasterise; while they are behind, it starts another scene instead of
+ * waiting (up to 64 in Mesa 22), and a binned triangle takes about 270 bytes: a draw of 10^7 small
+ * triangles (a large mesh at level 0, levels off or too close for a coarser one) held up to 450 MB
+ * of scenes at once, the peak of the whole `sy render` (a 10^7-triangle grid with levels off: 121
+ * bytes per triangle, 84 with the throttle). On a software rasterizer every THROTTLE_TRIANGLES
+ * drawn get a fence (which also hands the scene to the threads), and before a new fence the one
+ * THROTTLE_FENCES back is waited for, so at most that many chunks are binned and waiting; the
+ * threads stay busy, and the frame was faster (fewer fresh pages). A GPU keeps its own queue:
+ * there the waits would only leave it idle between chunks, so only llvmpipe and softpipe are
+ * throttled (and only their draws are cut into chunks). */
+static void throttle(sy_gl_device *dev, uint32_t tris)
+{
+    if (!dev->throttle || (dev->throttle_tris += tris) < THROTTLE_TRIANGLES) return;
+    const sy_gl_fns *gl = dev->gl;
+    dev->throttle_tris = 0;
+    GLsync *slot = &dev->fences[dev->fence_next];
+    if (*slot) { /* the wait ends when that chunk is rasterised (or the GL fails: nothing to hold then) */
+        GLenum w;
+        do w = gl->ClientWaitSync(*slot, GL_SYNC_FLUSH_COMMANDS_BIT, 1000000000u);
+        while (w == GL_TIMEOUT_EXPIRED);
+        gl->DeleteSync(*slot);
+    }
+    *slot = gl->FenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    dev->fence_next = (dev->fence_next + 1u) % THROTTLE_FENCES;
+}
+
+void sy_gli_throttle_free(sy_gl_device *dev)
+{
+    for (uint32_t i = 0; i < THROTTLE_FENCES; ++i)
+        if (dev->fences[i]) dev->gl->DeleteSync(dev->fences[i]), dev->fences[i] = 0;
+}
+
+/* Draws level `lod` of the mesh (0 or out of range = the mesh itself); returns the triangles drawn.
+ * On a software rasterizer in chunks of at most THROTTLE_TRIANGLES, throttled (above). */
 uint32_t sy_gli_draw_mesh_lod(sy_gl_device *dev, const mesh_o *m, uint32_t lod)
 {
     const sy_gl_fns *gl = dev->gl;
@@ -20,10 +54,15 @@ uint32_t sy_gli_draw_mesh_lod(sy_gl_device *dev, const mesh_o *m, uint32_t lod)
     if (lod >= m->lod_count) lod = 0;
     uint32_t tris = m->lod_tris[lod];
     double t0 = sy_gli_profile_thread(dev);
-    if (m->indexed)
-        gl->DrawElements(GL_TRIANGLES, (GLsizei)(3u * tris), GL_UNSIGNED_INT,
-                         (const void *)((uintptr_t)m->lod_first[lod] * sizeof(uint32_t)));
-    else gl->DrawArrays(GL_TRIANGLES, 0, (GLsizei)(3u * tris));
+    const uint32_t chunk = dev->throttle ? THROTTLE_TRIANGLES : tris;
+    for (uint32_t first = 0; first < tris; first += chunk) {
+        const uint32_t n = tris - first < chunk ? tris - first : chunk;
+        if (m->indexed)
+            gl->DrawElements(GL_TRIANGLES, (GLsizei)(3u * n), GL_UNSIGNED_INT,
+                             (const void *)(((uintptr_t)m->lod_first[lod] + 3u * (uintptr_t)first) * sizeof(uint32_t)));
+        else gl->DrawArrays(GL_TRIANGLES, (GLint)(3u * first), (GLsizei)(3u * n));
+        throttle(dev, n);
+    }
     sy_gli_profile_draw(dev, t0, "mesh");
     dev->draws++;
     return tris;

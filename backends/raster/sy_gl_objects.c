@@ -354,19 +354,52 @@ static void set_bounds(mesh_o *m, const float bmin[3], const float bmax[3])
     m->radius = sqrtf(r2);
 }
 
-static const int vertex_comps[5] = {3, 3, 2, 2, 4}; /* floats of position, normal, uv0, uv1, colour */
+static const int vertex_comps[5] = {3, 3, 2, 2, 4}; /* floats of position, normal, uv0, uv1, colour (given) */
+/* Bytes of each in the vertex buffer: the normal is packed into 4 (GL_INT_2_10_10_10_REV, signed
+ * normalised, the unit vector's components to 1/511; issue 39, memory on the user's path: 8 bytes
+ * less per vertex, 4 per triangle of a grid); the others stay floats. */
+static const int vertex_bytes[5] = {12, 4, 8, 8, 16};
+
+/* The unit normal n in GL_INT_2_10_10_10_REV (x in the low bits, w 0); a zero or non-finite normal
+ * packs to 0 (the float shaders normalised it to NaN either way). */
+static uint32_t pack_normal(const float n[3])
+{
+    const float len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    const float s = len > 0.0f && isfinite(len) ? 511.0f / len : 0.0f;
+    uint32_t p = 0;
+    for (int k = 0; k < 3; ++k) {
+        const float c = fminf(fmaxf(n[k] * s, -511.0f), 511.0f);
+        p |= ((uint32_t)(int32_t)lrintf(c) & 0x3ffu) << (10 * k);
+    }
+    return p;
+}
 
 /* The layout of the interleaved vertex buffer of the attributes present in arrays (position, normal,
  * uv0, uv1, colour; NULL = absent): offs the attributes' offsets and *stride the vertex size, in
- * floats; returns the buffer's bytes. */
+ * bytes; returns the buffer's bytes. */
 static size_t interleaved_layout(const sy_gl_mesh_desc *d, const float *const arrays[5], int offs[5], int *stride)
 {
     *stride = 0;
     for (int a = 0; a < 5; ++a) {
         offs[a] = *stride;
-        if (arrays[a]) *stride += vertex_comps[a];
+        if (arrays[a]) *stride += vertex_bytes[a];
     }
-    return (size_t)d->vertex_count * (size_t)*stride * sizeof(float);
+    return (size_t)d->vertex_count * (size_t)*stride;
+}
+
+/* The vertex attribute pointers of the bound vertex array to the bound GL_ARRAY_BUFFER, as
+ * interleaved_layout lays it out. */
+static void vertex_pointers(const sy_gl_fns *gl, const float *const arrays[5], const int offs[5], int stride)
+{
+    for (int a = 0; a < 5; ++a) {
+        if (!arrays[a]) continue;
+        gl->EnableVertexAttribArray((GLuint)a);
+        if (a == 1)
+            gl->VertexAttribPointer(1, 4, GL_INT_2_10_10_10_REV, GL_TRUE, stride, (const void *)(uintptr_t)offs[1]);
+        else
+            gl->VertexAttribPointer((GLuint)a, vertex_comps[a], GL_FLOAT, GL_FALSE, stride,
+                                    (const void *)(uintptr_t)offs[a]);
+    }
 }
 
 /* Vertices per piece of an interleaved upload. */
@@ -379,19 +412,26 @@ static bool upload_interleaved(const sy_gl_fns *gl, const sy_gl_mesh_desc *d, co
                                const int offs[5], int stride, const uint32_t *order)
 {
     uint32_t piece = d->vertex_count < UPLOAD_PIECE_VERTICES ? d->vertex_count : UPLOAD_PIECE_VERTICES;
-    float *vb = malloc((size_t)piece * (size_t)stride * sizeof(float));
+    unsigned char *vb = malloc((size_t)piece * (size_t)stride);
     if (!vb) return false;
     for (uint32_t first = 0; first < d->vertex_count; first += piece) {
         uint32_t count = d->vertex_count - first < piece ? d->vertex_count - first : piece;
         for (uint32_t i = 0; i < count; ++i) {
             size_t v = order ? order[first + i] : first + i;
-            for (int a = 0; a < 5; ++a)
-                if (arrays[a])
-                    memcpy(vb + (size_t)i * (size_t)stride + offs[a], arrays[a] + v * vertex_comps[a],
-                           vertex_comps[a] * sizeof(float));
+            unsigned char *out = vb + (size_t)i * (size_t)stride;
+            for (int a = 0; a < 5; ++a) {
+                if (!arrays[a]) continue;
+                const float *in = arrays[a] + v * (size_t)vertex_comps[a];
+                if (a == 1) {
+                    const uint32_t p = pack_normal(in);
+                    memcpy(out + offs[1], &p, sizeof p);
+                } else {
+                    memcpy(out + offs[a], in, (size_t)vertex_bytes[a]);
+                }
+            }
         }
-        gl->BufferSubData(GL_ARRAY_BUFFER, (GLintptr)((size_t)first * (size_t)stride * sizeof(float)),
-                          (GLsizeiptr)((size_t)count * (size_t)stride * sizeof(float)), vb);
+        gl->BufferSubData(GL_ARRAY_BUFFER, (GLintptr)((size_t)first * (size_t)stride),
+                          (GLsizeiptr)((size_t)count * (size_t)stride), vb);
     }
     free(vb);
     return true;
@@ -481,37 +521,22 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
     m->cap_closed = (int8_t)(d->closed > 0 ? 1 : d->closed < 0 ? -1 : 0);
     gl->GenVertexArrays(1, &m->vao);
     gl->BindVertexArray(m->vao);
-    /* one interleaved vertex buffer (present attributes only) + one index buffer */
-    const float *arrays[5] = {d->positions, d->normals, d->uv[0], d->uv[1], d->colors};
-    int stride, offs[5];
-    size_t bytes = interleaved_layout(d, arrays, offs, &stride);
-    gl->GenBuffers(1, &m->vbo[0]);
-    gl->BindBuffer(GL_ARRAY_BUFFER, m->vbo[0]);
-    gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)bytes, NULL, GL_STATIC_DRAW);
-    if (!upload_interleaved(gl, d, arrays, offs, stride, m->order)) {
-        free(lods), free(where);
-        gl->BindVertexArray(0);
-        sy_gl_mesh h = {m->h.id};
-        sy_gl_mesh_destroy(dev, h);
-        return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "mesh: out of memory (%u vertices)", d->vertex_count);
-    }
-    sy_gli_count_buffer(dev, false, bytes);
-    for (int a = 0; a < 5; ++a) {
-        m->has_attr[a] = arrays[a] != NULL;
-        if (!arrays[a]) continue;
-        gl->EnableVertexAttribArray((GLuint)a);
-        gl->VertexAttribPointer((GLuint)a, vertex_comps[a], GL_FLOAT, GL_FALSE, stride * (GLsizei)sizeof(float),
-                                (const void *)(uintptr_t)(offs[a] * sizeof(float)));
-    }
-    m->has_normals = d->normals != NULL;
+    /* one index buffer, then one interleaved vertex buffer: the index buffer first, so that the
+     * levels' indices and the renumbering (lods, where) are freed before the vertex buffer is
+     * taken */
     if (d->indices) {
         size_t bytes = index_count * sizeof(uint32_t);
         gl->GenBuffers(1, &m->ibo);
         gl->BindBuffer(GL_ELEMENT_ARRAY_BUFFER, m->ibo);
-        /* the mesh's indices, then the levels: no copy of the mesh's in between */
+        /* the mesh's indices, then the levels: no copy of the mesh's in between; the levels are
+         * written first and freed before level 0 fills its part (the buffer's pages are taken as
+         * they are written: the levels' copy, 4 bytes per triangle of a grid, is not held at once) */
         size_t n0 = 3u * (size_t)d->triangle_count * sizeof(uint32_t);
         gl->BufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)bytes, lods ? NULL : d->indices, GL_STATIC_DRAW);
-        if (lods && where) { /* level 0 renumbered a piece at a time */
+        const bool levels = lods != NULL;
+        if (levels) gl->BufferSubData(GL_ELEMENT_ARRAY_BUFFER, (GLintptr)n0, (GLsizeiptr)(bytes - n0), lods);
+        free(lods);
+        if (levels && where) { /* level 0 renumbered a piece at a time */
             uint32_t piece[16384];
             size_t count = n0 / sizeof(uint32_t);
             for (size_t first = 0; first < count; first += 16384u) {
@@ -520,15 +545,33 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
                 gl->BufferSubData(GL_ELEMENT_ARRAY_BUFFER, (GLintptr)(first * sizeof(uint32_t)),
                                   (GLsizeiptr)(c * sizeof(uint32_t)), piece);
             }
-        } else if (lods) {
+        } else if (levels) {
             gl->BufferSubData(GL_ELEMENT_ARRAY_BUFFER, 0, (GLsizeiptr)n0, d->indices);
         }
-        if (lods) gl->BufferSubData(GL_ELEMENT_ARRAY_BUFFER, (GLintptr)n0, (GLsizeiptr)(bytes - n0), lods);
-        free(lods);
         free(where);
         sy_gli_count_buffer(dev, false, bytes);
         m->indexed = true;
     }
+    /* one interleaved vertex buffer (present attributes only) */
+    const float *arrays[5] = {d->positions, d->normals, d->uv[0], d->uv[1], d->colors};
+    int stride, offs[5];
+    size_t bytes = interleaved_layout(d, arrays, offs, &stride);
+    gl->GenBuffers(1, &m->vbo[0]);
+    gl->BindBuffer(GL_ARRAY_BUFFER, m->vbo[0]);
+    gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)bytes, NULL, GL_STATIC_DRAW);
+    if (!upload_interleaved(gl, d, arrays, offs, stride, m->order)) {
+        gl->BindVertexArray(0);
+        sy_gl_mesh h = {m->h.id};
+        sy_gl_mesh_destroy(dev, h);
+        return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "mesh: out of memory (%u vertices)", d->vertex_count);
+    }
+    sy_gli_count_buffer(dev, false, bytes);
+    m->reordered = m->order != NULL; /* the order again only for an update (mesh_o.order) */
+    free(m->order);
+    m->order = NULL;
+    for (int a = 0; a < 5; ++a) m->has_attr[a] = arrays[a] != NULL;
+    vertex_pointers(gl, arrays, offs, stride);
+    m->has_normals = d->normals != NULL;
     gl->BindVertexArray(0);
     r = sy_gli_gl_check(dev, "mesh upload", rep);
     if (r != SY_GL_OK) {
@@ -538,6 +581,48 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
     }
     out->id = m->h.id;
     return SY_GL_OK;
+}
+
+/* mesh_o.order again for a reordered mesh, from its index buffer: level 0 there holds each corner's
+ * buffer position, d->indices (the mesh's, unchanged since its creation) its mesh vertex; the
+ * vertices no triangle uses follow the used ones in the mesh's order, as level_vertex_order placed
+ * them. NULL when it made the order, else why not (no memory; no indices, or not the mesh's). */
+static const char *order_from_buffer(const sy_gl_fns *gl, const sy_gl_mesh_desc *d, mesh_o *m)
+{
+    enum { PIECE = 16384 };
+    if (!d->indices) return "the mesh's indices are required";
+    uint32_t *o = malloc(sizeof *o * d->vertex_count), *piece = malloc(sizeof *piece * PIECE);
+    unsigned char *used = calloc(d->vertex_count, 1);
+    const char *why = o && piece && used ? NULL : "out of memory";
+    if (!why) {
+        memset(o, 0xff, sizeof *o * d->vertex_count);
+        gl->BindBuffer(GL_COPY_READ_BUFFER, m->ibo);
+        const size_t count = 3u * (size_t)d->triangle_count;
+        uint32_t next = 0;
+        for (size_t first = 0; first < count && !why; first += PIECE) {
+            const size_t c = count - first < PIECE ? count - first : PIECE;
+            gl->GetBufferSubData(GL_COPY_READ_BUFFER, (GLintptr)(first * sizeof *piece), (GLsizeiptr)(c * sizeof *piece), piece);
+            for (size_t i = 0; i < c && !why; ++i) {
+                const uint32_t b = piece[i], v = d->indices[first + i];
+                if (b >= d->vertex_count || v >= d->vertex_count || (o[b] != UINT32_MAX && o[b] != v)) {
+                    why = "its indices are not the ones it was made with";
+                    break;
+                }
+                o[b] = v;
+                next += !used[v];
+                used[v] = 1;
+            }
+        }
+        gl->BindBuffer(GL_COPY_READ_BUFFER, 0);
+        for (uint32_t p = 0; p < next && !why; ++p) /* the used vertices fill the first positions */
+            if (o[p] == UINT32_MAX) why = "its indices are not the ones it was made with";
+        for (uint32_t v = 0; v < d->vertex_count && !why; ++v)
+            if (!used[v]) o[next++] = v;
+    }
+    free(piece), free(used);
+    if (why) free(o), o = NULL;
+    m->order = o;
+    return why;
 }
 
 sy_gl_result sy_gl_mesh_update(sy_gl_device *dev, sy_gl_mesh mesh, const sy_gl_mesh_desc *d)
@@ -557,9 +642,13 @@ sy_gl_result sy_gl_mesh_update(sy_gl_device *dev, sy_gl_mesh mesh, const sy_gl_m
     sy_gl_result r = positions_box(d, "mesh update", bmin, bmax, rep);
     if (r == SY_GL_OK) r = sy_gli_current(dev, rep);
     if (r != SY_GL_OK) return r;
+    const sy_gl_fns *gl = dev->gl;
+    const char *why = m->reordered && !m->order ? order_from_buffer(gl, d, m) : NULL;
+    if (why)
+        return sy_gli_fail(rep, strcmp(why, "out of memory") ? SY_GL_ERROR_INVALID_ARGUMENT : SY_GL_ERROR_OUT_OF_MEMORY,
+                           "mesh update: %s (its vertex buffer is in the order of its levels, read back from them)", why);
     int stride, offs[5];
     size_t bytes = interleaved_layout(d, arrays, offs, &stride);
-    const sy_gl_fns *gl = dev->gl;
     gl->BindBuffer(GL_ARRAY_BUFFER, m->vbo[0]);
     bool ok = upload_interleaved(gl, d, arrays, offs, stride, m->order);
     gl->BindBuffer(GL_ARRAY_BUFFER, 0);

@@ -125,6 +125,10 @@ int main(int argc, char **argv)
     sy_gl_device_stats(d, &st);
     EXPECT_MSG(st.total.vertex_buffer_uploads == 2, "vertex uploads so far %llu (one interleaved vertex buffer + indices)",
                (unsigned long long)st.total.vertex_buffer_uploads);
+    /* 4 vertices of a float position, a normal packed into 4 bytes and a float uv, then 6 indices
+     * (the normal as 3 floats made it 152) */
+    EXPECT_MSG(st.total.vertex_bytes == 4u * (12u + 4u + 8u) + 6u * 4u, "vertex bytes so far %llu (want 120)",
+               (unsigned long long)st.total.vertex_bytes);
     float moved[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0.1f, 0, 0, 1};
     MUST(sy_gl_instance_set_transform(d, iq, moved));
     render(d, &cam);
@@ -355,6 +359,95 @@ int main(int argc, char **argv)
         EXPECT_MSG(near_(px(22, 30)[0], 17.0f * a22, 1e-5f), "MSAA edge is not premultiplied: %g vs alpha %g", px(22, 30)[0], a22);
         sy_gl_device_stats(d, &st);
         EXPECT_MSG(st.msaa_samples == 4, "msaa samples %u", st.msaa_samples);
+        sy_gl_device_destroy(d);
+    }
+
+    /* 7b. a draw of more triangles than the throttle's chunk (THROTTLE_TRIANGLES, 65536: llvmpipe's
+     * draws are cut into chunks with fences between) is drawn whole: a 300 x 300 grid at z = -3
+     * past every edge of the view, 180,000 triangles row after row, so a lost or repeated chunk
+     * leaves a band of the image empty; indexed, then as a triangle list. Levels of detail off. */
+    {
+        enum { G = 300 };
+        sy_gl_device_desc gd = {GL_TEST_REPORT, .provider = prov, .msaa = 1, .shadow_map_size = 256};
+        MUST(sy_gl_device_create(&gd, &d));
+        sy_gl_set_lod(d, 0.0f);
+        MUST(sy_gl_material_create(d, &emd, &em));
+        float *pos = malloc(sizeof *pos * 3u * (G + 1u) * (G + 1u)), *flat = malloc(sizeof *flat * 18u * G * G);
+        uint32_t *idx = malloc(sizeof *idx * 6u * G * G);
+        if (!pos || !flat || !idx) {
+            fprintf(stderr, "test_gl_backend: out of memory\n");
+            return 1;
+        }
+        for (uint32_t y = 0; y <= G; ++y)
+            for (uint32_t x = 0; x <= G; ++x) {
+                float *p = pos + 3u * (y * (G + 1u) + x);
+                p[0] = -3.3f + 6.6f * (float)x / G, p[1] = -3.3f + 6.6f * (float)y / G, p[2] = -3.0f;
+            }
+        for (uint32_t y = 0; y < G; ++y)
+            for (uint32_t x = 0; x < G; ++x) {
+                const uint32_t v = y * (G + 1u) + x, q[6] = {v, v + 1u, v + G + 2u, v, v + G + 2u, v + G + 1u};
+                for (int k = 0; k < 6; ++k) {
+                    idx[6u * (y * G + x) + (uint32_t)k] = q[k];
+                    memcpy(flat + 3u * (6u * (y * G + x) + (uint32_t)k), pos + 3u * q[k], 3 * sizeof(float));
+                }
+            }
+        for (int indexed = 1; indexed >= 0; --indexed) {
+            sy_gl_mesh_desc gm = {.positions = indexed ? pos : flat, .indices = indexed ? idx : NULL,
+                                  .vertex_count = indexed ? (G + 1u) * (G + 1u) : 6u * G * G, .triangle_count = 2u * G * G};
+            sy_gl_mesh m;
+            MUST(sy_gl_mesh_create(d, &gm, &m));
+            sy_gl_instance in = gl_test_place(d, m, em);
+            render(d, &cam);
+            int empty = 0, first = -1;
+            for (int i = 0; i < N * N; ++i)
+                if (rgba[4 * i + 3] != 1.0f || rgba[4 * i] != 17.0f || !near_(depth[i], 3.0f, 1e-5f)) empty += first < 0 ? (first = i, 1) : 1;
+            sy_gl_device_stats(d, &st);
+            EXPECT_MSG(empty == 0 && st.triangles_drawn == 2u * G * G,
+                       "%s grid of %u triangles: %d of %d pixels not covered (the first at row %d), %llu triangles drawn",
+                       indexed ? "indexed" : "unindexed", 2u * G * G, empty, N * N, first / N, (unsigned long long)st.triangles_drawn);
+            MUST(sy_gl_instance_destroy(d, in));
+            MUST(sy_gl_mesh_destroy(d, m));
+        }
+        /* an update of a mesh whose vertex buffer is in the order of its levels (90,601 vertices:
+         * more than LOD_REORDER_VERTICES; its order is freed after the upload and read back from
+         * the index buffer by the first update): the grid tilted and moved as an update and as a
+         * new mesh give the same depth at every pixel */
+        static float upd_depth[N * N];
+        for (int fresh = 0; fresh < 2; ++fresh) {
+            sy_gl_mesh_desc gm = {.positions = pos, .indices = idx, .vertex_count = (G + 1u) * (G + 1u), .triangle_count = 2u * G * G};
+            sy_gl_mesh m;
+            if (fresh)
+                for (uint32_t v = 0; v < gm.vertex_count; ++v) pos[3u * v + 2] = -3.0f - 0.05f * pos[3u * v] + 0.03f * pos[3u * v + 1];
+            MUST(sy_gl_mesh_create(d, &gm, &m));
+            if (!fresh) {
+                /* refused before the order is read back: no indices, an index out of range, other
+                 * indices than the mesh's */
+                sy_gl_mesh_desc bad = gm;
+                bad.indices = NULL;
+                EXPECT_MSG(sy_gl_mesh_update(d, m, &bad) == SY_GL_ERROR_INVALID_ARGUMENT && strstr(e, "indices are required"),
+                           "update without indices: %s", e);
+                const uint32_t keep = idx[0];
+                idx[0] = gm.vertex_count + 7u;
+                EXPECT_MSG(sy_gl_mesh_update(d, m, &gm) == SY_GL_ERROR_INVALID_ARGUMENT && strstr(e, "not the ones it was made with"),
+                           "update with an index out of range: %s", e);
+                idx[0] = keep ^ 1u;
+                EXPECT_MSG(sy_gl_mesh_update(d, m, &gm) == SY_GL_ERROR_INVALID_ARGUMENT && strstr(e, "not the ones it was made with"),
+                           "update with other indices: %s", e);
+                idx[0] = keep;
+                for (uint32_t v = 0; v < gm.vertex_count; ++v) pos[3u * v + 2] = -3.0f - 0.05f * pos[3u * v] + 0.03f * pos[3u * v + 1];
+                MUST(sy_gl_mesh_update(d, m, &gm));
+                for (uint32_t v = 0; v < gm.vertex_count; ++v) pos[3u * v + 2] = -3.0f;
+            }
+            sy_gl_instance in = gl_test_place(d, m, em);
+            render(d, &cam);
+            if (!fresh) memcpy(upd_depth, depth, sizeof depth);
+            MUST(sy_gl_instance_destroy(d, in));
+            MUST(sy_gl_mesh_destroy(d, m));
+        }
+        int differ = 0;
+        for (int i = 0; i < N * N; ++i) differ += upd_depth[i] != depth[i] || !(depth[i] > 2.0f && depth[i] < 4.0f);
+        EXPECT_MSG(differ == 0, "the updated grid's depth differs from the new grid's at %d of %d pixels", differ, N * N);
+        free(pos), free(flat), free(idx);
         sy_gl_device_destroy(d);
     }
 
