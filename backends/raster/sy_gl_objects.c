@@ -355,10 +355,24 @@ static void set_bounds(mesh_o *m, const float bmin[3], const float bmax[3])
 }
 
 static const int vertex_comps[5] = {3, 3, 2, 2, 4}; /* floats of position, normal, uv0, uv1, colour (given) */
-/* Bytes of each in the vertex buffer: the normal is packed into 4 (GL_INT_2_10_10_10_REV, signed
- * normalised, the unit vector's components to 1/511; issue 39, memory on the user's path: 8 bytes
- * less per vertex, 4 per triangle of a grid); the others stay floats. */
-static const int vertex_bytes[5] = {12, 4, 8, 8, 16};
+
+/* The interleaved vertex buffer of a mesh (issue 39, memory on the user's path): the position and
+ * colour as floats; the normal packed into 4 bytes (GL_INT_2_10_10_10_REV, signed normalised: the
+ * unit vector's components to 1/511, about 0.1 degree; 8 bytes less per vertex); a uv set whose
+ * coordinates all lie in [0, 1] as two 16-bit unsigned normalised numbers (to 1/65535: an eighth of
+ * a texel of an 8192-texel texture; 4 bytes less), another as floats (repeating textures). */
+typedef struct vertex_layout {
+    int offs[5], stride; /* bytes */
+    bool uv16[2];        /* uv0, uv1 in 16 bits */
+} vertex_layout;
+
+/* Whether the n uv pairs all lie in [0, 1] (NaN does not). */
+static bool uv_fits_16(const float *uv, uint32_t n)
+{
+    for (size_t i = 0; i < 2u * (size_t)n; ++i)
+        if (!(uv[i] >= 0.0f && uv[i] <= 1.0f)) return false;
+    return true;
+}
 
 /* The unit normal n in GL_INT_2_10_10_10_REV (x in the low bits, w 0); a zero or non-finite normal
  * packs to 0 (the float shaders normalised it to NaN either way). */
@@ -374,31 +388,38 @@ static uint32_t pack_normal(const float n[3])
     return p;
 }
 
-/* The layout of the interleaved vertex buffer of the attributes present in arrays (position, normal,
- * uv0, uv1, colour; NULL = absent): offs the attributes' offsets and *stride the vertex size, in
- * bytes; returns the buffer's bytes. */
-static size_t interleaved_layout(const sy_gl_mesh_desc *d, const float *const arrays[5], int offs[5], int *stride)
+/* Bytes of attribute a in layout l. */
+static int attr_bytes(const vertex_layout *l, int a)
 {
-    *stride = 0;
-    for (int a = 0; a < 5; ++a) {
-        offs[a] = *stride;
-        if (arrays[a]) *stride += vertex_bytes[a];
-    }
-    return (size_t)d->vertex_count * (size_t)*stride;
+    return a == 1 ? 4 : (a == 2 || a == 3) && l->uv16[a - 2] ? 4 : vertex_comps[a] * (int)sizeof(float);
 }
 
-/* The vertex attribute pointers of the bound vertex array to the bound GL_ARRAY_BUFFER, as
- * interleaved_layout lays it out. */
-static void vertex_pointers(const sy_gl_fns *gl, const float *const arrays[5], const int offs[5], int stride)
+/* The layout of the interleaved vertex buffer of the attributes present in arrays (position, normal,
+ * uv0, uv1, colour; NULL = absent), the uv sets in 16 bits where uv16 says (only sets that fit:
+ * uv_fits_16); returns the buffer's bytes. */
+static size_t interleaved_layout(const sy_gl_mesh_desc *d, const float *const arrays[5], const bool uv16[2],
+                                 vertex_layout *l)
+{
+    l->uv16[0] = uv16[0], l->uv16[1] = uv16[1];
+    l->stride = 0;
+    for (int a = 0; a < 5; ++a) {
+        l->offs[a] = l->stride;
+        if (arrays[a]) l->stride += attr_bytes(l, a);
+    }
+    return (size_t)d->vertex_count * (size_t)l->stride;
+}
+
+/* The vertex attribute pointers of the bound vertex array to the bound GL_ARRAY_BUFFER, as l lays
+ * it out. */
+static void vertex_pointers(const sy_gl_fns *gl, const float *const arrays[5], const vertex_layout *l)
 {
     for (int a = 0; a < 5; ++a) {
         if (!arrays[a]) continue;
+        const void *at = (const void *)(uintptr_t)l->offs[a];
         gl->EnableVertexAttribArray((GLuint)a);
-        if (a == 1)
-            gl->VertexAttribPointer(1, 4, GL_INT_2_10_10_10_REV, GL_TRUE, stride, (const void *)(uintptr_t)offs[1]);
-        else
-            gl->VertexAttribPointer((GLuint)a, vertex_comps[a], GL_FLOAT, GL_FALSE, stride,
-                                    (const void *)(uintptr_t)offs[a]);
+        if (a == 1) gl->VertexAttribPointer(1, 4, GL_INT_2_10_10_10_REV, GL_TRUE, l->stride, at);
+        else if (attr_bytes(l, a) == 4) gl->VertexAttribPointer((GLuint)a, 2, GL_UNSIGNED_SHORT, GL_TRUE, l->stride, at);
+        else gl->VertexAttribPointer((GLuint)a, vertex_comps[a], GL_FLOAT, GL_FALSE, l->stride, at);
     }
 }
 
@@ -409,29 +430,32 @@ static void vertex_pointers(const sy_gl_fns *gl, const float *const arrays[5], c
  * UPLOAD_PIECE_VERTICES at a time (a 10^7-triangle mesh's whole interleaved copy was 16 bytes per
  * triangle at the peak, issue 39). false without memory. */
 static bool upload_interleaved(const sy_gl_fns *gl, const sy_gl_mesh_desc *d, const float *const arrays[5],
-                               const int offs[5], int stride, const uint32_t *order)
+                               const vertex_layout *l, const uint32_t *order)
 {
     uint32_t piece = d->vertex_count < UPLOAD_PIECE_VERTICES ? d->vertex_count : UPLOAD_PIECE_VERTICES;
-    unsigned char *vb = malloc((size_t)piece * (size_t)stride);
+    unsigned char *vb = malloc((size_t)piece * (size_t)l->stride);
     if (!vb) return false;
     for (uint32_t first = 0; first < d->vertex_count; first += piece) {
         uint32_t count = d->vertex_count - first < piece ? d->vertex_count - first : piece;
         for (uint32_t i = 0; i < count; ++i) {
             size_t v = order ? order[first + i] : first + i;
-            unsigned char *out = vb + (size_t)i * (size_t)stride;
+            unsigned char *out = vb + (size_t)i * (size_t)l->stride;
             for (int a = 0; a < 5; ++a) {
                 if (!arrays[a]) continue;
                 const float *in = arrays[a] + v * (size_t)vertex_comps[a];
                 if (a == 1) {
                     const uint32_t p = pack_normal(in);
-                    memcpy(out + offs[1], &p, sizeof p);
+                    memcpy(out + l->offs[1], &p, sizeof p);
+                } else if (attr_bytes(l, a) == 4) { /* a uv set in [0, 1] (uv_fits_16) */
+                    const uint16_t q[2] = {(uint16_t)lrintf(in[0] * 65535.0f), (uint16_t)lrintf(in[1] * 65535.0f)};
+                    memcpy(out + l->offs[a], q, sizeof q);
                 } else {
-                    memcpy(out + offs[a], in, (size_t)vertex_bytes[a]);
+                    memcpy(out + l->offs[a], in, (size_t)vertex_comps[a] * sizeof(float));
                 }
             }
         }
-        gl->BufferSubData(GL_ARRAY_BUFFER, (GLintptr)((size_t)first * (size_t)stride),
-                          (GLsizeiptr)((size_t)count * (size_t)stride), vb);
+        gl->BufferSubData(GL_ARRAY_BUFFER, (GLintptr)((size_t)first * (size_t)l->stride),
+                          (GLsizeiptr)((size_t)count * (size_t)l->stride), vb);
     }
     free(vb);
     return true;
@@ -554,12 +578,14 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
     }
     /* one interleaved vertex buffer (present attributes only) */
     const float *arrays[5] = {d->positions, d->normals, d->uv[0], d->uv[1], d->colors};
-    int stride, offs[5];
-    size_t bytes = interleaved_layout(d, arrays, offs, &stride);
+    const bool uv16[2] = {d->uv[0] && uv_fits_16(d->uv[0], d->vertex_count), d->uv[1] && uv_fits_16(d->uv[1], d->vertex_count)};
+    vertex_layout layout;
+    size_t bytes = interleaved_layout(d, arrays, uv16, &layout);
+    m->uv16[0] = uv16[0], m->uv16[1] = uv16[1];
     gl->GenBuffers(1, &m->vbo[0]);
     gl->BindBuffer(GL_ARRAY_BUFFER, m->vbo[0]);
     gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)bytes, NULL, GL_STATIC_DRAW);
-    if (!upload_interleaved(gl, d, arrays, offs, stride, m->order)) {
+    if (!upload_interleaved(gl, d, arrays, &layout, m->order)) {
         gl->BindVertexArray(0);
         sy_gl_mesh h = {m->h.id};
         sy_gl_mesh_destroy(dev, h);
@@ -570,7 +596,7 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
     free(m->order);
     m->order = NULL;
     for (int a = 0; a < 5; ++a) m->has_attr[a] = arrays[a] != NULL;
-    vertex_pointers(gl, arrays, offs, stride);
+    vertex_pointers(gl, arrays, &layout);
     m->has_normals = d->normals != NULL;
     gl->BindVertexArray(0);
     r = sy_gli_gl_check(dev, "mesh upload", rep);
@@ -647,10 +673,21 @@ sy_gl_result sy_gl_mesh_update(sy_gl_device *dev, sy_gl_mesh mesh, const sy_gl_m
     if (why)
         return sy_gli_fail(rep, strcmp(why, "out of memory") ? SY_GL_ERROR_INVALID_ARGUMENT : SY_GL_ERROR_OUT_OF_MEMORY,
                            "mesh update: %s (its vertex buffer is in the order of its levels, read back from them)", why);
-    int stride, offs[5];
-    size_t bytes = interleaved_layout(d, arrays, offs, &stride);
+    /* a uv set in 16 bits stays so while it fits; one that leaves [0, 1] turns the buffer to floats
+     * for good (a new buffer and attribute pointers) */
+    const bool uv16[2] = {m->uv16[0] && uv_fits_16(d->uv[0], d->vertex_count), m->uv16[1] && uv_fits_16(d->uv[1], d->vertex_count)};
+    const bool relayout = uv16[0] != m->uv16[0] || uv16[1] != m->uv16[1];
+    vertex_layout layout;
+    size_t bytes = interleaved_layout(d, arrays, uv16, &layout);
     gl->BindBuffer(GL_ARRAY_BUFFER, m->vbo[0]);
-    bool ok = upload_interleaved(gl, d, arrays, offs, stride, m->order);
+    if (relayout) gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)bytes, NULL, GL_STATIC_DRAW);
+    bool ok = upload_interleaved(gl, d, arrays, &layout, m->order);
+    if (ok && relayout) {
+        gl->BindVertexArray(m->vao);
+        vertex_pointers(gl, arrays, &layout);
+        gl->BindVertexArray(0);
+        m->uv16[0] = uv16[0], m->uv16[1] = uv16[1];
+    }
     gl->BindBuffer(GL_ARRAY_BUFFER, 0);
     if (!ok) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "mesh update: out of memory (%u vertices)", d->vertex_count);
     sy_gli_count_buffer(dev, false, bytes);

@@ -125,9 +125,9 @@ int main(int argc, char **argv)
     sy_gl_device_stats(d, &st);
     EXPECT_MSG(st.total.vertex_buffer_uploads == 2, "vertex uploads so far %llu (one interleaved vertex buffer + indices)",
                (unsigned long long)st.total.vertex_buffer_uploads);
-    /* 4 vertices of a float position, a normal packed into 4 bytes and a float uv, then 6 indices
-     * (the normal as 3 floats made it 152) */
-    EXPECT_MSG(st.total.vertex_bytes == 4u * (12u + 4u + 8u) + 6u * 4u, "vertex bytes so far %llu (want 120)",
+    /* 4 vertices of a float position, a normal packed into 4 bytes and a uv in [0, 1] in two 16-bit
+     * numbers, then 6 indices (3 floats of normal and 2 of uv made it 152) */
+    EXPECT_MSG(st.total.vertex_bytes == 4u * (12u + 4u + 4u) + 6u * 4u, "vertex bytes so far %llu (want 104)",
                (unsigned long long)st.total.vertex_bytes);
     float moved[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0.1f, 0, 0, 1};
     MUST(sy_gl_instance_set_transform(d, iq, moved));
@@ -448,6 +448,48 @@ int main(int argc, char **argv)
         for (int i = 0; i < N * N; ++i) differ += upd_depth[i] != depth[i] || !(depth[i] > 2.0f && depth[i] < 4.0f);
         EXPECT_MSG(differ == 0, "the updated grid's depth differs from the new grid's at %d of %d pixels", differ, N * N);
         free(pos), free(flat), free(idx);
+
+        /* 7c. a uv set beyond [0, 1] stays in floats (8 bytes a vertex, not 4), and an update that
+         * takes a 16-bit set beyond [0, 1] turns its buffer to floats: a quad updated from uv 0..1
+         * to 0..2 (a repeating 4x4 texture of 16 values) shows what the same quad made with 0..2
+         * shows, at every pixel */
+        unsigned char tex[4 * 4 * 3];
+        for (int i = 0; i < 48; ++i) tex[i] = (unsigned char)(i * 5);
+        sy_gl_texture_desc td = {.width = 4, .height = 4, .channels = 3, .format = SY_GL_TEXEL_UNORM8, .pixels = tex};
+        sy_gl_texture t;
+        MUST(sy_gl_texture_create(d, &td, &t));
+        sy_gl_material mt = unlit_textured(d, t);
+        const float near_q[12] = {-1, -1, -2, 1, -1, -2, 1, 1, -2, -1, 1, -2};
+        static const float uv1[8] = {0, 0, 1, 0, 1, 1, 0, 1}, uv2[8] = {0, 0, 2, 0, 2, 2, 0, 2};
+        static float upd_rgba[N * N * 4];
+        for (int fresh = 0; fresh < 2; ++fresh) {
+            sy_gl_device_stats(d, &st);
+            const uint64_t before = st.total.vertex_bytes;
+            sy_gl_mesh m = gl_test_quad(d, near_q, nz, fresh ? uv2 : uv1);
+            sy_gl_device_stats(d, &st);
+            const uint64_t want = 4u * (12u + 4u + (fresh ? 8u : 4u)) + 6u * 4u;
+            EXPECT_MSG(st.total.vertex_bytes - before == want, "a quad with uv 0..%d: %llu vertex bytes (want %llu)", fresh ? 2 : 1,
+                       (unsigned long long)(st.total.vertex_bytes - before), (unsigned long long)want);
+            if (!fresh) {
+                static const uint32_t qi[6] = {0, 1, 2, 0, 2, 3};
+                float qn[12];
+                for (int i = 0; i < 4; ++i) memcpy(qn + 3 * i, nz, sizeof nz);
+                sy_gl_mesh_desc ud = {.positions = near_q, .normals = qn, .uv = {uv2, NULL}, .indices = qi, .vertex_count = 4, .triangle_count = 2};
+                MUST(sy_gl_mesh_update(d, m, &ud));
+            }
+            sy_gl_instance in = gl_test_place(d, m, mt);
+            render(d, &cam);
+            if (!fresh) memcpy(upd_rgba, rgba, sizeof rgba);
+            MUST(sy_gl_instance_destroy(d, in));
+            MUST(sy_gl_mesh_destroy(d, m));
+        }
+        int texel_differ = 0, textured = 0;
+        for (int i = 0; i < N * N; ++i) {
+            texel_differ += memcmp(upd_rgba + 4 * i, rgba + 4 * i, 4 * sizeof(float)) != 0;
+            textured += rgba[4 * i + 3] == 1.0f;
+        }
+        EXPECT_MSG(texel_differ == 0 && textured == 32 * 32, "the quad updated to uv 0..2 differs at %d pixels (%d covered)",
+                   texel_differ, textured);
         sy_gl_device_destroy(d);
     }
 
