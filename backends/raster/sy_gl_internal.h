@@ -118,7 +118,7 @@ typedef struct mesh_o {
     GLuint vao, vbo[1], ibo;
     uint32_t vertex_count, triangle_count;
     bool has_normals, indexed, has_attr[5];
-    bool uv16[2]; /* uv0 / uv1 in the vertex buffer as 16-bit unsigned normalised (sy_gl_objects.c, vertex_layout) */
+    bool packed;  /* the vertex buffer holds packed normals or uvs (sy_gl_objects.c, vertex_layout): not yet updated */
     float bmin[3], bmax[3];
     float centre[3], radius;     /* bounding sphere of the box (object space) */
     uint32_t lod_count;          /* levels, 1 = the mesh only */

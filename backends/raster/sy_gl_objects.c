@@ -360,10 +360,13 @@ static const int vertex_comps[5] = {3, 3, 2, 2, 4}; /* floats of position, norma
  * colour as floats; the normal packed into 4 bytes (GL_INT_2_10_10_10_REV, signed normalised: the
  * unit vector's components to 1/511, about 0.1 degree; 8 bytes less per vertex); a uv set whose
  * coordinates all lie in [0, 1] as two 16-bit unsigned normalised numbers (to 1/65535: an eighth of
- * a texel of an 8192-texel texture; 4 bytes less), another as floats (repeating textures). */
+ * a texel of an 8192-texel texture; 4 bytes less), another as floats (repeating textures). A mesh
+ * that is updated (a skin, a morph) goes to floats throughout at its first update: packing cost
+ * a 10^5-vertex skin 1.4 ms a frame (`sy bench deform`, raster 4.1 -> 5.6 ms), and memory counts
+ * where meshes are large and still. */
 typedef struct vertex_layout {
     int offs[5], stride; /* bytes */
-    bool uv16[2];        /* uv0, uv1 in 16 bits */
+    bool n10, uv16[2];   /* the normal in 10-bit components, uv0 and uv1 in 16 bits */
 } vertex_layout;
 
 /* Whether the n uv pairs all lie in [0, 1] (NaN does not). */
@@ -391,16 +394,16 @@ static uint32_t pack_normal(const float n[3])
 /* Bytes of attribute a in layout l. */
 static int attr_bytes(const vertex_layout *l, int a)
 {
-    return a == 1 ? 4 : (a == 2 || a == 3) && l->uv16[a - 2] ? 4 : vertex_comps[a] * (int)sizeof(float);
+    return (a == 1 && l->n10) || ((a == 2 || a == 3) && l->uv16[a - 2]) ? 4 : vertex_comps[a] * (int)sizeof(float);
 }
 
 /* The layout of the interleaved vertex buffer of the attributes present in arrays (position, normal,
- * uv0, uv1, colour; NULL = absent), the uv sets in 16 bits where uv16 says (only sets that fit:
- * uv_fits_16); returns the buffer's bytes. */
-static size_t interleaved_layout(const sy_gl_mesh_desc *d, const float *const arrays[5], const bool uv16[2],
-                                 vertex_layout *l)
+ * uv0, uv1, colour; NULL = absent): packed (a mesh's creation) or all floats (its updates), the uv
+ * sets packed only where they fit (uv_fits_16); returns the buffer's bytes. */
+static size_t interleaved_layout(const sy_gl_mesh_desc *d, const float *const arrays[5], bool packed, vertex_layout *l)
 {
-    l->uv16[0] = uv16[0], l->uv16[1] = uv16[1];
+    l->n10 = packed;
+    for (int k = 0; k < 2; ++k) l->uv16[k] = packed && arrays[2 + k] && uv_fits_16(arrays[2 + k], d->vertex_count);
     l->stride = 0;
     for (int a = 0; a < 5; ++a) {
         l->offs[a] = l->stride;
@@ -417,8 +420,8 @@ static void vertex_pointers(const sy_gl_fns *gl, const float *const arrays[5], c
         if (!arrays[a]) continue;
         const void *at = (const void *)(uintptr_t)l->offs[a];
         gl->EnableVertexAttribArray((GLuint)a);
-        if (a == 1) gl->VertexAttribPointer(1, 4, GL_INT_2_10_10_10_REV, GL_TRUE, l->stride, at);
-        else if (attr_bytes(l, a) == 4) gl->VertexAttribPointer((GLuint)a, 2, GL_UNSIGNED_SHORT, GL_TRUE, l->stride, at);
+        if (a == 1 && l->n10) gl->VertexAttribPointer(1, 4, GL_INT_2_10_10_10_REV, GL_TRUE, l->stride, at);
+        else if (a != 1 && attr_bytes(l, a) == 4) gl->VertexAttribPointer((GLuint)a, 2, GL_UNSIGNED_SHORT, GL_TRUE, l->stride, at);
         else gl->VertexAttribPointer((GLuint)a, vertex_comps[a], GL_FLOAT, GL_FALSE, l->stride, at);
     }
 }
@@ -443,10 +446,10 @@ static bool upload_interleaved(const sy_gl_fns *gl, const sy_gl_mesh_desc *d, co
             for (int a = 0; a < 5; ++a) {
                 if (!arrays[a]) continue;
                 const float *in = arrays[a] + v * (size_t)vertex_comps[a];
-                if (a == 1) {
+                if (a == 1 && l->n10) {
                     const uint32_t p = pack_normal(in);
                     memcpy(out + l->offs[1], &p, sizeof p);
-                } else if (attr_bytes(l, a) == 4) { /* a uv set in [0, 1] (uv_fits_16) */
+                } else if (a != 1 && attr_bytes(l, a) == 4) { /* a uv set in [0, 1] (uv_fits_16) */
                     const uint16_t q[2] = {(uint16_t)lrintf(in[0] * 65535.0f), (uint16_t)lrintf(in[1] * 65535.0f)};
                     memcpy(out + l->offs[a], q, sizeof q);
                 } else {
@@ -578,10 +581,9 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
     }
     /* one interleaved vertex buffer (present attributes only) */
     const float *arrays[5] = {d->positions, d->normals, d->uv[0], d->uv[1], d->colors};
-    const bool uv16[2] = {d->uv[0] && uv_fits_16(d->uv[0], d->vertex_count), d->uv[1] && uv_fits_16(d->uv[1], d->vertex_count)};
     vertex_layout layout;
-    size_t bytes = interleaved_layout(d, arrays, uv16, &layout);
-    m->uv16[0] = uv16[0], m->uv16[1] = uv16[1];
+    size_t bytes = interleaved_layout(d, arrays, true, &layout);
+    m->packed = layout.n10 || layout.uv16[0] || layout.uv16[1];
     gl->GenBuffers(1, &m->vbo[0]);
     gl->BindBuffer(GL_ARRAY_BUFFER, m->vbo[0]);
     gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)bytes, NULL, GL_STATIC_DRAW);
@@ -673,12 +675,11 @@ sy_gl_result sy_gl_mesh_update(sy_gl_device *dev, sy_gl_mesh mesh, const sy_gl_m
     if (why)
         return sy_gli_fail(rep, strcmp(why, "out of memory") ? SY_GL_ERROR_INVALID_ARGUMENT : SY_GL_ERROR_OUT_OF_MEMORY,
                            "mesh update: %s (its vertex buffer is in the order of its levels, read back from them)", why);
-    /* a uv set in 16 bits stays so while it fits; one that leaves [0, 1] turns the buffer to floats
-     * for good (a new buffer and attribute pointers) */
-    const bool uv16[2] = {m->uv16[0] && uv_fits_16(d->uv[0], d->vertex_count), m->uv16[1] && uv_fits_16(d->uv[1], d->vertex_count)};
-    const bool relayout = uv16[0] != m->uv16[0] || uv16[1] != m->uv16[1];
+    /* the first update turns a packed buffer to floats for good (a new buffer and attribute
+     * pointers; vertex_layout) */
+    const bool relayout = m->packed;
     vertex_layout layout;
-    size_t bytes = interleaved_layout(d, arrays, uv16, &layout);
+    size_t bytes = interleaved_layout(d, arrays, false, &layout);
     gl->BindBuffer(GL_ARRAY_BUFFER, m->vbo[0]);
     if (relayout) gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)bytes, NULL, GL_STATIC_DRAW);
     bool ok = upload_interleaved(gl, d, arrays, &layout, m->order);
@@ -686,7 +687,7 @@ sy_gl_result sy_gl_mesh_update(sy_gl_device *dev, sy_gl_mesh mesh, const sy_gl_m
         gl->BindVertexArray(m->vao);
         vertex_pointers(gl, arrays, &layout);
         gl->BindVertexArray(0);
-        m->uv16[0] = uv16[0], m->uv16[1] = uv16[1];
+        m->packed = false;
     }
     gl->BindBuffer(GL_ARRAY_BUFFER, 0);
     if (!ok) return sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, "mesh update: out of memory (%u vertices)", d->vertex_count);

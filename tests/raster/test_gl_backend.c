@@ -449,10 +449,10 @@ int main(int argc, char **argv)
         EXPECT_MSG(differ == 0, "the updated grid's depth differs from the new grid's at %d of %d pixels", differ, N * N);
         free(pos), free(flat), free(idx);
 
-        /* 7c. a uv set beyond [0, 1] stays in floats (8 bytes a vertex, not 4), and an update that
-         * takes a 16-bit set beyond [0, 1] turns its buffer to floats: a quad updated from uv 0..1
-         * to 0..2 (a repeating 4x4 texture of 16 values) shows what the same quad made with 0..2
-         * shows, at every pixel */
+        /* 7c. a uv set beyond [0, 1] stays in floats (8 bytes a vertex, not 4), and a mesh's first
+         * update turns its packed buffer to floats: a quad updated from uv 0..1 to 0..2 (a
+         * repeating 4x4 texture of 16 values) shows what the same quad made with 0..2 shows, at
+         * every pixel */
         unsigned char tex[4 * 4 * 3];
         for (int i = 0; i < 48; ++i) tex[i] = (unsigned char)(i * 5);
         sy_gl_texture_desc td = {.width = 4, .height = 4, .channels = 3, .format = SY_GL_TEXEL_UNORM8, .pixels = tex};
