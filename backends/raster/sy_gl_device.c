@@ -42,9 +42,9 @@ sy_gl_result sy_gl_device_create(const sy_gl_device_desc *desc, sy_gl_device **o
     dev->profile_var = -1;
     double prof[2];
     sy_gli_profile_mark(dev, true, prof);
-    snprintf(dev->info, sizeof dev->info, "OpenGL %s on %s (%s)", (const char *)gl->GetString(GL_VERSION),
-             (const char *)gl->GetString(GL_RENDERER), sy_gl_provider_name(dd.provider));
     const char *renderer = (const char *)gl->GetString(GL_RENDERER);
+    snprintf(dev->info, sizeof dev->info, "OpenGL %s on %s (%s)", (const char *)gl->GetString(GL_VERSION), renderer,
+             sy_gl_provider_name(dd.provider));
     dev->throttle = renderer && (strstr(renderer, "llvmpipe") || strstr(renderer, "softpipe")); /* sy_gl_lod.c */
     GLint max_samples = 1, max_tex = 2048;
     gl->GetIntegerv(GL_MAX_SAMPLES, &max_samples);
