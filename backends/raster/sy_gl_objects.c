@@ -391,10 +391,13 @@ static uint32_t pack_normal(const float n[3])
     return p;
 }
 
+/* Whether attribute a is a uv set that l holds in 16 bits. */
+static bool attr_uv16(const vertex_layout *l, int a) { return (a == 2 || a == 3) && l->uv16[a - 2]; }
+
 /* Bytes of attribute a in layout l. */
 static int attr_bytes(const vertex_layout *l, int a)
 {
-    return (a == 1 && l->n10) || ((a == 2 || a == 3) && l->uv16[a - 2]) ? 4 : vertex_comps[a] * (int)sizeof(float);
+    return (a == 1 && l->n10) || attr_uv16(l, a) ? 4 : vertex_comps[a] * (int)sizeof(float);
 }
 
 /* The layout of the interleaved vertex buffer of the attributes present in arrays (position, normal,
@@ -421,7 +424,7 @@ static void vertex_pointers(const sy_gl_fns *gl, const float *const arrays[5], c
         const void *at = (const void *)(uintptr_t)l->offs[a];
         gl->EnableVertexAttribArray((GLuint)a);
         if (a == 1 && l->n10) gl->VertexAttribPointer(1, 4, GL_INT_2_10_10_10_REV, GL_TRUE, l->stride, at);
-        else if (a != 1 && attr_bytes(l, a) == 4) gl->VertexAttribPointer((GLuint)a, 2, GL_UNSIGNED_SHORT, GL_TRUE, l->stride, at);
+        else if (attr_uv16(l, a)) gl->VertexAttribPointer((GLuint)a, 2, GL_UNSIGNED_SHORT, GL_TRUE, l->stride, at);
         else gl->VertexAttribPointer((GLuint)a, vertex_comps[a], GL_FLOAT, GL_FALSE, l->stride, at);
     }
 }
@@ -449,7 +452,7 @@ static bool upload_interleaved(const sy_gl_fns *gl, const sy_gl_mesh_desc *d, co
                 if (a == 1 && l->n10) {
                     const uint32_t p = pack_normal(in);
                     memcpy(out + l->offs[1], &p, sizeof p);
-                } else if (a != 1 && attr_bytes(l, a) == 4) { /* a uv set in [0, 1] (uv_fits_16) */
+                } else if (attr_uv16(l, a)) { /* a uv set in [0, 1] (uv_fits_16) */
                     const uint16_t q[2] = {(uint16_t)lrintf(in[0] * 65535.0f), (uint16_t)lrintf(in[1] * 65535.0f)};
                     memcpy(out + l->offs[a], q, sizeof q);
                 } else {
@@ -614,15 +617,17 @@ sy_gl_result sy_gl_mesh_create(sy_gl_device *dev, const sy_gl_mesh_desc *d, sy_g
 /* mesh_o.order again for a reordered mesh, from its index buffer: level 0 there holds each corner's
  * buffer position, d->indices (the mesh's, unchanged since its creation) its mesh vertex; the
  * vertices no triangle uses follow the used ones in the mesh's order, as level_vertex_order placed
- * them. NULL when it made the order, else why not (no memory; no indices, or not the mesh's). */
-static const char *order_from_buffer(const sy_gl_fns *gl, const sy_gl_mesh_desc *d, mesh_o *m)
+ * them. Fails without memory, without indices or with others than the mesh's. */
+static sy_gl_result order_from_buffer(const sy_gl_fns *gl, const sy_gl_mesh_desc *d, mesh_o *m, sy_gl_report *rep)
 {
     enum { PIECE = 16384 };
-    if (!d->indices) return "the mesh's indices are required";
+    static const char *const fmt = "mesh update: %s (its vertex buffer is in the order of its levels, read back from them)";
+    if (!d->indices) return sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, fmt, "the mesh's indices are required");
     uint32_t *o = malloc(sizeof *o * d->vertex_count), *piece = malloc(sizeof *piece * PIECE);
     unsigned char *used = calloc(d->vertex_count, 1);
-    const char *why = o && piece && used ? NULL : "out of memory";
-    if (!why) {
+    const char *why = NULL; /* indices other than the mesh's */
+    const bool memory = o && piece && used;
+    if (memory) {
         memset(o, 0xff, sizeof *o * d->vertex_count);
         gl->BindBuffer(GL_COPY_READ_BUFFER, m->ibo);
         const size_t count = 3u * (size_t)d->triangle_count;
@@ -648,9 +653,13 @@ static const char *order_from_buffer(const sy_gl_fns *gl, const sy_gl_mesh_desc 
             if (!used[v]) o[next++] = v;
     }
     free(piece), free(used);
-    if (why) free(o), o = NULL;
+    if (!memory || why) {
+        free(o);
+        return memory ? sy_gli_fail(rep, SY_GL_ERROR_INVALID_ARGUMENT, fmt, why)
+                      : sy_gli_fail(rep, SY_GL_ERROR_OUT_OF_MEMORY, fmt, "out of memory");
+    }
     m->order = o;
-    return why;
+    return SY_GL_OK;
 }
 
 sy_gl_result sy_gl_mesh_update(sy_gl_device *dev, sy_gl_mesh mesh, const sy_gl_mesh_desc *d)
@@ -671,10 +680,7 @@ sy_gl_result sy_gl_mesh_update(sy_gl_device *dev, sy_gl_mesh mesh, const sy_gl_m
     if (r == SY_GL_OK) r = sy_gli_current(dev, rep);
     if (r != SY_GL_OK) return r;
     const sy_gl_fns *gl = dev->gl;
-    const char *why = m->reordered && !m->order ? order_from_buffer(gl, d, m) : NULL;
-    if (why)
-        return sy_gli_fail(rep, strcmp(why, "out of memory") ? SY_GL_ERROR_INVALID_ARGUMENT : SY_GL_ERROR_OUT_OF_MEMORY,
-                           "mesh update: %s (its vertex buffer is in the order of its levels, read back from them)", why);
+    if (m->reordered && !m->order && (r = order_from_buffer(gl, d, m, rep)) != SY_GL_OK) return r;
     /* the first update turns a packed buffer to floats for good (a new buffer and attribute
      * pointers; vertex_layout) */
     const bool relayout = m->packed;
