@@ -26,7 +26,9 @@
 //     frame every SY_ORBIT_EVERY_MS (default 250; sy.capture: the pixels before the browser shows
 //     them, whether they are an estimate, the view, the share the hole fill left empty).
 //     SY_ORBIT_HOLD=1: the references held from the start (sy.hold), so that every capture is
-//     the first frame warped by the angle turned since, whatever the server and the load do.
+//     the first frame warped by the angle turned since, whatever the server and the load do; the
+//     orbit's clock then moves at most 50 ms a display frame (a stalled display takes the same
+//     captures at the same angles, later; `ms` is that clock).
 //     Then, for each capture that was an estimate, the server's exact frame of the same view (a
 //     drag back to it, waited for until a full-size frame answers it, captured): OUTDIR/est_K.png
 //     and OUTDIR/true_K.png, K from 0, compared by SY_PNG_SSIM (tests/support/png_ssim.c: SSIM of
@@ -392,20 +394,25 @@ try {
     const run = await page.evaluate(([degS, secs, everyMs, held]) => new Promise((done) => {
       const DEG_PER_PX = 0.008 * 180 / Math.PI; // view.js applyInput: 0.008 rad of yaw per pixel
       const caps = window.__caps = [], cum = [0], id0 = syStats.lastInput;
-      let t0 = null, last = 0, nextCap = 0;
+      // the orbit's own clock: wall time, but when held at most STEP_MS a display frame, so that
+      // a display stalled by load (Chromium on two busy cores: 400 ms between frames seen) takes
+      // the same captures at the same angles, only later
+      const STEP_MS = held ? 50 : Infinity;
+      let t0 = null, last = 0, clock = 0, nextCap = everyMs;
       if (held) sy.hold(true);
       function tick(t) {
-        if (t0 === null) { t0 = last = t; nextCap = t + everyMs; requestAnimationFrame(tick); return; }
-        const dx = degS * (t - last) / 1000 / DEG_PER_PX;
+        if (t0 === null) { t0 = last = t; requestAnimationFrame(tick); return; }
+        const dt = Math.min(t - last, STEP_MS), dx = degS * dt / 1000 / DEG_PER_PX;
         last = t;
+        clock += dt;
         sy.input({ t: 'drag', dx: dx, dy: 0, b: 0 });
         cum.push(cum[cum.length - 1] + dx);
-        if (t >= nextCap) {
+        if (clock >= nextCap) {
           nextCap += everyMs;
-          const ms = t - t0;
+          const ms = clock;
           sy.capture().then((c) => { c.ms = ms; caps.push(c); });
         }
-        if (t - t0 < secs * 1000) requestAnimationFrame(tick);
+        if (clock < secs * 1000) requestAnimationFrame(tick);
         else sy.capture().then(() => { if (held) sy.hold(false); done({ id0: id0, cum: cum }); });
       }
       requestAnimationFrame(tick);
