@@ -38,7 +38,8 @@
  * Samples: area lights n = ceil(area_light_samples / pixel_samples) per shading point (by default
  * 8 per pixel for the closed form's visibility, 16 for the sampled estimators), each a
  * polygon chosen in proportion to its closed-form light and a direction uniform in the solid angle
- * of one of its triangles (Arvo 1995), so the samples' weights vary little and the ratio of few
+ * of one of its triangles (Arvo 1995) where the point is near it, through a uniform point on it from
+ * farther away (sample_tri), so the samples' weights vary little and the ratio of few
  * samples is nearly the visibility the BSDF sees; a point none of whose samples reached an emitter
  * (under the horizon) draws up to RETRIES more. The environment env_light_samples per shading
  * point, each an environment and a BSDF sample (MIS). The numbers come from the pixel's
@@ -629,40 +630,48 @@ static float quad_split(const sy_rt_area_tri *t0, const sy_rt_area_tri *t1, sy_r
 static sy_rt_v3 gram_schmidt(sy_rt_v3 v, sy_rt_v3 w) { return v3_sub(v, v3_scale(w, v3_dot(v, w))); }
 
 /* A direction wi from x toward triangle t, uniform in its solid angle (Arvo 1995, as pbrt-v4
- * writes it), the point q it reaches and 1 / its pdf; a triangle under about 1e-4 sr (or
- * degenerate) gets a uniform point on its area instead (1 / pdf = area cos / d^2). False: no
- * direction. */
+ * writes it), the point q it reaches and 1 / its pdf, where x is near the triangle: its longest
+ * edge longer than x's distance to its plane (Cycles' rule; there area |cos| / d^2 varies most over
+ * the triangle). A triangle farther away, under about 1e-4 sr or degenerate gets a uniform point on
+ * its area instead (1 / pdf = area cos / d^2): its weights vary little, and it skips the
+ * trigonometry (EmissiveStrengthTest, emitters mostly seen from afar: Whitted 0.90x the time,
+ * relMSE 0.00057 -> 0.00061 against 256 spp). False: no direction. */
 static bool sample_tri(const sy_rt_area_tri *t, sy_rt_v3 x, float u1, float u2, sy_rt_v3 *wi, sy_rt_v3 *q, float *w)
 {
-    sy_rt_v3 p1 = v3_add(t->p0, t->e1), p2 = v3_add(t->p0, t->e2);
-    sy_rt_v3 a = v3_normalize(v3_sub(t->p0, x)), b = v3_normalize(v3_sub(p1, x)), c = v3_normalize(v3_sub(p2, x));
-    sy_rt_v3 nab = v3_cross(a, b), nca = v3_cross(c, a);
-    float lab = v3_length(nab), lca = v3_length(nca);
-    /* the solid angle (spherical excess) by Van Oosterom and Strackee's tan(E / 2) = |a . (b x c)| /
-     * (1 + a.b + b.c + c.a): one atan2f, and exact for small triangles where the sum of the three
-     * angles minus pi loses its digits */
-    float area_sa = 2.0f * atan2f(fabsf(v3_dot(a, v3_cross(b, c))), 1.0f + v3_dot(a, b) + v3_dot(b, c) + v3_dot(c, a));
-    if (lab > 1e-6f && lca > 1e-6f) {
-        /* alpha, the angle at a: between the planes (a, b) and (a, c) */
-        float ca = sy_rt_clampf(-v3_dot(nab, nca) / (lab * lca), -1.0f, 1.0f), sa = sqrtf(1.0f - ca * ca);
-        if (area_sa > 1e-4f && isfinite(area_sa) && sa > 0.0f) {
-            float sx, cx; /* sin and cos of pi + u1 area_sa: -sin, -cos of u1 area_sa */
-            sx = sinf(u1 * area_sa), cx = cosf(u1 * area_sa);
-            float sphi = -sx * ca + cx * sa, cphi = -cx * ca - sx * sa;
-            float k1 = cphi + ca, k2 = sphi - sa * v3_dot(a, b);
-            float cbp = (k2 + (k2 * cphi - k1 * sphi) * ca) / ((k2 * sphi + k1 * cphi) * sa);
-            cbp = sy_rt_clampf(isfinite(cbp) ? cbp : 1.0f, -1.0f, 1.0f);
-            float sbp = sqrtf(fmaxf(0.0f, 1.0f - cbp * cbp));
-            sy_rt_v3 cp = v3_add(v3_scale(a, cbp), v3_scale(v3_normalize(gram_schmidt(c, a)), sbp));
-            float ct = 1.0f - u2 * (1.0f - v3_dot(cp, b)), st = sqrtf(fmaxf(0.0f, 1.0f - ct * ct));
-            sy_rt_v3 d = v3_add(v3_scale(b, ct), v3_scale(v3_normalize(gram_schmidt(cp, b)), st));
-            float dn = v3_dot(d, t->normal);
-            float tt = v3_dot(v3_sub(t->p0, x), t->normal) / dn;
-            if (isfinite(tt) && tt > 0.0f && isfinite(d.x + d.y + d.z)) {
-                *wi = d;
-                *q = v3_madd(x, d, tt);
-                *w = area_sa;
-                return true;
+    float h = v3_dot(t->normal, v3_sub(t->p0, x));
+    sy_rt_v3 e3 = v3_sub(t->e2, t->e1);
+    float l2 = sy_rt_maxf(v3_dot(t->e1, t->e1), sy_rt_maxf(v3_dot(t->e2, t->e2), v3_dot(e3, e3)));
+    if (l2 > h * h) {
+        sy_rt_v3 p1 = v3_add(t->p0, t->e1), p2 = v3_add(t->p0, t->e2);
+        sy_rt_v3 a = v3_normalize(v3_sub(t->p0, x)), b = v3_normalize(v3_sub(p1, x)), c = v3_normalize(v3_sub(p2, x));
+        sy_rt_v3 nab = v3_cross(a, b), nca = v3_cross(c, a);
+        float lab = v3_length(nab), lca = v3_length(nca);
+        /* the solid angle (spherical excess) by Van Oosterom and Strackee's tan(E / 2) = |a . (b x c)| /
+         * (1 + a.b + b.c + c.a): one atan2f, and exact for small triangles where the sum of the three
+         * angles minus pi loses its digits */
+        float area_sa = 2.0f * atan2f(fabsf(v3_dot(a, v3_cross(b, c))), 1.0f + v3_dot(a, b) + v3_dot(b, c) + v3_dot(c, a));
+        if (lab > 1e-6f && lca > 1e-6f) {
+            /* alpha, the angle at a: between the planes (a, b) and (a, c) */
+            float ca = sy_rt_clampf(-v3_dot(nab, nca) / (lab * lca), -1.0f, 1.0f), sa = sqrtf(1.0f - ca * ca);
+            if (area_sa > 1e-4f && isfinite(area_sa) && sa > 0.0f) {
+                float sx, cx; /* sin and cos of pi + u1 area_sa: -sin, -cos of u1 area_sa */
+                sx = sinf(u1 * area_sa), cx = cosf(u1 * area_sa);
+                float sphi = -sx * ca + cx * sa, cphi = -cx * ca - sx * sa;
+                float k1 = cphi + ca, k2 = sphi - sa * v3_dot(a, b);
+                float cbp = (k2 + (k2 * cphi - k1 * sphi) * ca) / ((k2 * sphi + k1 * cphi) * sa);
+                cbp = sy_rt_clampf(isfinite(cbp) ? cbp : 1.0f, -1.0f, 1.0f);
+                float sbp = sqrtf(fmaxf(0.0f, 1.0f - cbp * cbp));
+                sy_rt_v3 cp = v3_add(v3_scale(a, cbp), v3_scale(v3_normalize(gram_schmidt(c, a)), sbp));
+                float ct = 1.0f - u2 * (1.0f - v3_dot(cp, b)), st = sqrtf(fmaxf(0.0f, 1.0f - ct * ct));
+                sy_rt_v3 d = v3_add(v3_scale(b, ct), v3_scale(v3_normalize(gram_schmidt(cp, b)), st));
+                float dn = v3_dot(d, t->normal);
+                float tt = v3_dot(v3_sub(t->p0, x), t->normal) / dn;
+                if (isfinite(tt) && tt > 0.0f && isfinite(d.x + d.y + d.z)) {
+                    *wi = d;
+                    *q = v3_madd(x, d, tt);
+                    *w = area_sa;
+                    return true;
+                }
             }
         }
     }
@@ -679,8 +688,9 @@ static bool sample_tri(const sy_rt_area_tri *t, sy_rt_v3 x, float u1, float u2, 
 
 /* Area lights with the model m: the analytic unshadowed light of every emissive triangle, and
  * n_area samples, each picking a polygon in proportion to its analytic light (luminance) and a
- * direction uniform in its solid angle, for the visibility ratio (with weights nearly constant
- * over the emitter, the ratio of few samples is nearly the visibility the BSDF sees). */
+ * direction toward one of its triangles (sample_tri: uniform in its solid angle where near), for the
+ * visibility ratio (with weights nearly constant over the emitter, the ratio of few samples is
+ * nearly the visibility the BSDF sees). */
 static sy_rt_v3 direct_area_analytic(trace_ctx *c, const sy_rt_surface *s, const sy_rt_bsdf *b, amodel *m,
                                      sy_rt_v3 p_off, sy_rt_v3 wo, uint32_t depth)
 {

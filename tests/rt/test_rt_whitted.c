@@ -1,6 +1,6 @@
 /* test_rt_whitted.c — radiometry of the Whitted integrator against analytic values: visible
  * emitters, Lambert under point / spot / directional lights, an area light (rectangle form
- * factor; and one seen at a grazing angle), hard shadows where the geometry says, mirror reflection, glass transmission with
+ * factor; one seen at a grazing angle; one half hidden, near and far), hard shadows where the geometry says, mirror reflection, glass transmission with
  * Fresnel, alpha-mask cut-outs and textured unlit materials; the analytic (LTC) area light (a square, a lone triangle) exact
  * with one sample where nothing occludes it, a rough sphere under an environment map smooth
  * pixel to pixel, and renders bit-identical run to run. */
@@ -183,6 +183,41 @@ static void test_area_light_grazing(void)
     EXPECT_MSG(rt_near(c[0], expect, 0.01), "area light at a grazing angle: %.6g, expected %.6g", c[0], expect);
     rt_image_free(rgba, depth);
     sy_rt_device_destroy(dev);
+}
+
+/* A square emitter (half-size s, z = 0.5, facing down) half hidden from the floor point under its
+ * centre by a blocker over x < 0 at z = 0.25: every segment from the origin to an emitter point of
+ * x < 0 crosses it, so the point sees exactly half the light (by symmetry). Whitted's light is the
+ * closed form times the visibility ratio of its samples, drawn uniformly in the solid angle of a
+ * near emitter (s = 1: edges longer than the height) and through points uniform on the area of a
+ * far one (s = 0.1): either way half of the unshadowed value. */
+static void test_area_light_half_shadow(void)
+{
+    static const float half[2] = {0.1f, 1.0f};
+    for (int k = 0; k < 2; ++k) {
+        sy_rt_device *dev = rt_device();
+        const float albedo = 0.8f, le = 3.0f, s = half[k];
+        float xf[16], em[16], bl[16];
+        rt_identity(xf);
+        rt_place(dev, rt_quad(dev, 10.0f), xf, rt_lambert(dev, albedo, albedo, albedo), 0);
+        rt_rot_y(em, (float)M_PI, 0.0f, 0.0f, 0.5f);
+        rt_place(dev, rt_quad(dev, s), em, rt_emitter(dev, le, le, le), 0);
+        rt_translation(bl, -10.0f, 0.0f, 0.25f);
+        rt_place(dev, rt_quad(dev, 10.0f), bl, rt_lambert(dev, albedo, albedo, albedo), 0);
+        MUST(sy_rt_commit(dev));
+        sy_rt_camera cam = rt_camera(0.2f, 0.002f); /* below the blocker, the floor within +-0.0004 */
+        sy_rt_render_desc rd = rt_desc(SY_RT_INTEGRATOR_WHITTED, 4, 4);
+        rd.area_light_samples = 1024;
+        float *rgba, *depth;
+        rt_render(dev, &cam, &rd, &rgba, &depth);
+        double mean = 0.0;
+        for (int i = 0; i < 16; ++i) mean += rgba[4 * i] / 16.0;
+        double expect = 0.5 * albedo / M_PI * rt_square_irradiance_at(le, s, 0.5, 0.0);
+        EXPECT_MSG(rt_near(mean, expect, 0.02), "half-shadowed %s emitter (half-size %.1f): %.6g, expected %.6g",
+                   k ? "near" : "far", s, mean, expect);
+        rt_image_free(rgba, depth);
+        sy_rt_device_destroy(dev);
+    }
 }
 
 static void test_hard_shadow(void)
@@ -521,6 +556,7 @@ int main(void)
     test_point_and_directional();
     test_area_light();
     test_area_light_grazing();
+    test_area_light_half_shadow();
     test_area_light_analytic();
     test_area_light_analytic_triangle();
     test_rough_sphere_smooth_and_deterministic();
