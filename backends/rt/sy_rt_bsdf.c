@@ -84,6 +84,13 @@ static void frame(sy_rt_bsdf *b)
     b->b = v3(bb, sign + n.y * n.y * a, -n.y);
 }
 
+/* Whether evaluating b means its diffuse lobe alone: no specular layer (KHR_materials_specular 0),
+ * no metal, sheen or glossy coat (transmission and mirrors are not evaluated). */
+static bool lambert_only(const sy_rt_bsdf *b)
+{
+    return b->spec == 0.0f && b->q_metal == 0.0f && b->q_sheen == 0.0f && (b->cc_delta || !(b->q_coat > 0.0f));
+}
+
 void sy_rt_bsdf_init(sy_rt_bsdf *b, const sy_rt_surface *s, sy_rt_v3 wo)
 {
     const sy_rt_material_desc *d = &s->mat->desc;
@@ -164,6 +171,7 @@ void sy_rt_bsdf_init(sy_rt_bsdf *b, const sy_rt_surface *s, sy_rt_v3 wo)
     } else {
         b->q_metal = b->q_spec = b->q_diff = b->q_coat = b->q_trans = b->q_sheen = 0.0f;
     }
+    b->lambert = lambert_only(b);
 }
 
 /* The dielectric's Fresnel (x specular) and the metal's at cosine c, with the thin film mixed in
@@ -200,6 +208,10 @@ static inline sy_rt_v3 bsdf_eval_wo(const sy_rt_bsdf *b, sy_rt_v3 wo, float nv, 
     *pdf = 0.0f;
     float nl = v3_dot(b->n, wi);
     if (nl <= 0.0f || nv <= 0.0f || v3_dot(b->ng, wi) <= 0.0f) return v3(0.0f, 0.0f, 0.0f);
+    if (b->lambert) { /* the diffuse lobe alone: no half vector (the Fresnel below is 0 x Schlick) */
+        *pdf = b->q_diff * nl * INV_PI;
+        return v3_scale(v3_scale(b->base, b->w_diel * INV_PI), nl);
+    }
     sy_rt_v3 h = v3_normalize(v3_add(wo, wi));
     float vh = sy_rt_maxf(v3_dot(wo, h), 0.0f);
     sy_rt_v3 fs = fresnel_diel(b, vh);
@@ -393,6 +405,7 @@ void sy_rt_pt_record_bsdf_batch(const sy_rt_pt_record *r, uint32_t count, const 
     b.aniso = p[33] != 0.0f, b.t = v3(p[34], p[35], p[36]), b.ax = p[37], b.ay = p[38];
     b.b = v3_cross(b.n, b.t);
     b.cc_n = p[39] != 0.0f, b.ncc = v3(p[40], p[41], p[42]);
+    b.lambert = lambert_only(&b);
     sy_rt_v3 wo = v3(r->wo[0], r->wo[1], r->wo[2]);
     float nv = v3_dot(b.n, wo), lv = bsdf_glossy(&b) && nv > 0.0f ? ggx_lambda(b.alpha * b.alpha, nv) : -1.0f;
     for (uint32_t m = 0; m < count; ++m) {

@@ -47,6 +47,7 @@ typedef struct sy_rt_bsdf {
     float ior, f0d;     /* ((ior - 1) / (ior + 1))^2 */
     sy_rt_v3 f0c;       /* dielectric F0: min(f0d x KHR_materials_specular colour, 1) */
     float spec;         /* KHR_materials_specular factor: scales the dielectric Fresnel term */
+    bool lambert;       /* only the diffuse lobe is evaluated (spec 0, no metal, sheen or glossy coat) */
     float w_metal, w_diel, w_trans; /* the base's lobes, already x base_scale */
     float cc, cc_alpha; /* KHR_materials_clearcoat: weight and GGX alpha of the coat (F0 0.04) */
     bool cc_delta;      /* the coat is a smooth mirror */
