@@ -345,7 +345,9 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
             out->depth = v3_dot(v3_sub(s.p, f->cam_pos), f->forward);
             first = false;
         }
-        if (s.mat->emissive && (s.front || s.mat->desc.double_sided)) {
+        /* an emitter's light, where it is not black (a textured emitter's black texels add
+         * nothing: no MIS weight, whose light-tree pdf walks the tree) */
+        if (s.mat->emissive && (s.front || s.mat->desc.double_sided) && !v3_is_zero(s.emission)) {
             float w = 1.0f;
             if (!specular) {
                 float dist = rh.ray.tfar, cos_l = fabsf(v3_dot(s.ng, d));
@@ -354,7 +356,8 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
                 uint32_t ai = sy_rt_area_index(dev, in, rh.hit.primID);
                 sy_rt_area_tri moved;
                 const sy_rt_area_tri *at = ai != UINT32_MAX ? sy_rt_area_at(&dev->area[ai], c->ictx.time, &moved) : NULL;
-                if (!j->lt) pdf_a = at == &moved ? moved.pdf_select : sy_rt_area_pdf(dev, in);
+                /* (none for a triangle light sampling leaves out: zero area) */
+                if (at && !j->lt) pdf_a = at == &moved ? moved.pdf_select : sy_rt_area_pdf(dev, in);
                 else if (at) pdf_a = sy_rt_lighttree_pdf(j->lt, prev_p, prev_n, ai) / at->area;
                 float pdf_l = cos_l > 0.0f ? pdf_a * dist * dist / cos_l * p_area_sel : 0.0f;
                 w = power_heuristic(pdf_prev, pdf_l);
