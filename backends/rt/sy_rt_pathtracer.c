@@ -356,9 +356,9 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
                 uint32_t ai = sy_rt_area_index(dev, in, rh.hit.primID);
                 sy_rt_area_tri moved;
                 const sy_rt_area_tri *at = ai != UINT32_MAX ? sy_rt_area_at(&dev->area[ai], c->ictx.time, &moved) : NULL;
-                /* (none for a triangle light sampling leaves out: zero area) */
-                if (at && !j->lt) pdf_a = at == &moved ? moved.pdf_select : sy_rt_area_pdf(dev, in);
-                else if (at) pdf_a = sy_rt_lighttree_pdf(j->lt, prev_p, prev_n, ai) / at->area;
+                if (at) /* (none for a triangle light sampling leaves out: zero area) */
+                    pdf_a = j->lt ? sy_rt_lighttree_pdf(j->lt, prev_p, prev_n, ai) / at->area
+                            : at == &moved ? moved.pdf_select : sy_rt_area_pdf(dev, in);
                 float pdf_l = cos_l > 0.0f ? pdf_a * dist * dist / cos_l * p_area_sel : 0.0f;
                 w = power_heuristic(pdf_prev, pdf_l);
             }

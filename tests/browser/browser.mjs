@@ -398,10 +398,10 @@ try {
       // a display stalled by load (Chromium on two busy cores: 400 ms between frames seen) takes
       // the same captures at the same angles, only later
       const STEP_MS = held ? 50 : Infinity;
-      let t0 = null, last = 0, clock = 0, nextCap = everyMs;
+      let last = null, clock = 0, nextCap = everyMs;
       if (held) sy.hold(true);
       function tick(t) {
-        if (t0 === null) { t0 = last = t; requestAnimationFrame(tick); return; }
+        if (last === null) { last = t; requestAnimationFrame(tick); return; }
         const dt = Math.min(t - last, STEP_MS), dx = degS * dt / 1000 / DEG_PER_PX;
         last = t;
         clock += dt;
