@@ -51,7 +51,7 @@
  * to call (an interactive view's resolution scale): the history is read at its own size.
  *
  * Ownership: a sy_filter_temporal is the caller's (create / destroy); it holds two frames of history
- * and its working planes (about 420 bytes per pixel). Thread-safety: one thread at a time per object; the passes run on the
+ * and its working planes (about 345 bytes per pixel). Thread-safety: one thread at a time per object; the passes run on the
  * process's OpenMP team (sy_filter_parallel_rows); results do not depend on the thread count, nor on
  * the instruction set (the row loops' AVX-512, AVX2 and SSE2 clones and the reprojection's AVX2 and
  * scalar versions do the same operations per pixel). */
