@@ -21,10 +21,11 @@
  * and the blend of the direct part too (no copies).
  *
  * Memory: planes plane_stride apart (not a multiple of 4 KiB: the same pixel of 60 planes would share
- * one L1 set), the neighbourhood passes prefetch the next 128 columns of every plane they read
+ * one L1 set), the a-trous passes prefetch the next 128 columns of every plane they read
  * (prefetch_cols: more streams than the hardware prefetchers follow), and the integration pass
  * keeps its per-block statistics and reprojected history in stack scratch (docs/FILTERS.md, "The
- * memory pass": the stage 30.6 -> 24.6 ms per 640x360 frame on 2 cores, bit for bit the same).
+ * memory pass": with the variance blur computed row by row inside the a-trous pass, the stage
+ * 29.6 -> 22.2 ms per 640x360 frame on 2 cores, bit for bit the same).
  *
  * Cost per 640x360 frame (callgrind, `sy bench temporal ... --cost-frames 2`, the stage with its
  * feature buffers' read): about 500 M instructions before these (the reprojection 142 M scalar,
@@ -288,12 +289,13 @@ static inline void tap_span(int w, int off, int *x0, int *x1)
 }
 
 /* Software prefetch of the columns [x0, x1) of k rows p[0..k-1] (offset by off floats: a tap's
- * column shift) into the L1 cache, one request per cache line. The neighbourhood passes read the
- * same columns of 20-60 planes at once, more streams than the hardware prefetchers follow: without
- * it every new line of every plane is a demand miss. Their row loops run in chunks of PF_COLS
- * columns and, before each, request the next chunk's lines (measured on the a-trous passes, 640x360,
- * one thread: 33.5 -> 25.5 ms a frame; 64 columns: 26.2). A prefetch is only a hint: addresses are
- * formed inside the planes (the caller clips the columns), nothing is read that the pass would not. */
+ * column shift) into the L1 cache, one request per cache line. An a-trous pass reads the same
+ * columns of up to 60 planes at once, more streams than the hardware prefetchers follow: without it
+ * every new line of every plane is a demand miss. Its row loop runs in chunks of PF_COLS columns
+ * and, before each, requests the next chunk's lines (`sy bench temporal`, 640x360, one thread: the
+ * a-trous phase 33.5 -> 25.5 ms a frame; chunks of 64 columns: 26.2). A prefetch is only a hint:
+ * addresses are formed inside the planes (the caller clips the columns), nothing is read that the
+ * pass would not. */
 enum { PF_COLS = 128 };
 static inline void prefetch_cols(const float *const *p, int k, int off, int x0, int x1)
 {
@@ -680,35 +682,34 @@ static void stops_row2(int w, float sl, float sz, const float *restrict vw, cons
     }
 }
 
-/* Before an a-trous pass: the variance blurred 3x3 (B-spline, step 1) over pixels of the centre's
- * class, turned into the pass's luminance edge stop 1 / (sigma_l sqrt(blurred) + 1e-6), and the
- * depth edge stop 1 / (sigma_z step zgrad + 1e-6 z + 1e-9); with c->two, both parts' (the blur's
- * weights and the depth stop are the same for both) */
-static void vblur_rows(void *vc, uint32_t y0, uint32_t y1)
+/* The edge stops of an a-trous pass at row y: the variance blurred 3x3 (B-spline, step 1) over
+ * pixels of the centre's class, turned into the pass's luminance edge stop 1 / (sigma_l
+ * sqrt(blurred) + 1e-6), and the depth edge stop 1 / (sigma_z step zgrad + 1e-6 z + 1e-9); with
+ * c->two, both parts' (the blur's weights and the depth stop are the same for both). atrous_rows
+ * calls it for each row just before filtering it: it reads the pass's source rows y-1..y+1, which
+ * the pass does not write, and its output row is still in the cache when the row is filtered. */
+static void vblur_row(const tctx *c, int y)
 {
     static const float hk[3] = {0.25f, 0.5f, 0.25f};
-    tctx *c = vc;
     const sy_filter_temporal_params *P = &c->t->p;
     int w = (int)c->in->width, hgt = (int)c->in->height;
     const float *cls = plane(c, W_CLS), *V = c->vsrc, *Z = plane(c, W_Z), *G = plane(c, W_ZG);
     float *IL = plane(c, W_IL), *IZ = plane(c, W_IZ), *WS = plane(c, W_WS);
     float sl = P->sigma_luminance, sz = P->sigma_depth * (float)c->step;
-    for (int y = (int)y0; y < (int)y1; ++y) {
-        size_t row = (size_t)y * w;
-        float *vb = IL + row, *vw = WS + row, *vb2 = plane(c, W_IL2) + row;
-        memset(vb, 0, (size_t)w * sizeof(float));
-        memset(vw, 0, (size_t)w * sizeof(float));
-        if (c->two) memset(vb2, 0, (size_t)w * sizeof(float));
-        tap3 taps[9];
-        for (int k = 0, n = row_taps(w, hgt, y, 1, taps); k < n; ++k) {
-            const tap3 *t = &taps[k];
-            float kk = hk[t->dx + 1] * hk[t->dy + 1];
-            if (c->two) vblur_tap2(t->x0, t->x1, kk, cls + t->o, V + t->o, c->vsrc2 + t->o, cls + row, vb, vb2, vw);
-            else vblur_tap(t->x0, t->x1, kk, cls + t->o, V + t->o, cls + row, vb, vw);
-        }
-        if (c->two) stops_row2(w, sl, sz, vw, G + row, Z + row, IL + row, vb2, IZ + row);
-        else stops_row(w, sl, sz, vw, G + row, Z + row, IL + row, IZ + row);
+    size_t row = (size_t)y * w;
+    float *vb = IL + row, *vw = WS + row, *vb2 = plane(c, W_IL2) + row;
+    memset(vb, 0, (size_t)w * sizeof(float));
+    memset(vw, 0, (size_t)w * sizeof(float));
+    if (c->two) memset(vb2, 0, (size_t)w * sizeof(float));
+    tap3 taps[9];
+    for (int k = 0, n = row_taps(w, hgt, y, 1, taps); k < n; ++k) {
+        const tap3 *t = &taps[k];
+        float kk = hk[t->dx + 1] * hk[t->dy + 1];
+        if (c->two) vblur_tap2(t->x0, t->x1, kk, cls + t->o, V + t->o, c->vsrc2 + t->o, cls + row, vb, vb2, vw);
+        else vblur_tap(t->x0, t->x1, kk, cls + t->o, V + t->o, cls + row, vb, vw);
     }
+    if (c->two) stops_row2(w, sl, sz, vw, G + row, Z + row, IL + row, vb2, IZ + row);
+    else stops_row(w, sl, sz, vw, G + row, Z + row, IL + row, IZ + row);
 }
 
 /* an a-trous row's sums start with the centre's kernel weight k0 */
@@ -857,6 +858,7 @@ static void atrous_rows(void *vc, uint32_t y0, uint32_t y1)
     int xa = s < w ? s : w, xb = w - s > xa ? w - s : xa;
     for (int y = (int)y0; y < (int)y1; ++y) {
         size_t row = (size_t)y * w;
+        vblur_row(c, y);
         if (xb > xa) {
             /* class, depth, normal 3; per part colour 3, variance: rows u, m, d */
             const float *P[13][3];
@@ -1035,7 +1037,6 @@ sy_filter_status sy_filter_temporal_run(sy_filter_temporal *t, const sy_filter_f
         c.src = src[0], c.vsrc = vsrc[0], c.dst = dst[0], c.vdst = vdst[0];
         c.src2 = src[1], c.vsrc2 = vsrc[1], c.dst2 = dst[1], c.vdst2 = vdst[1];
         c.step = 1 << it;
-        sy_filter_parallel_rows(th, rows, vblur_rows, &c);
         sy_filter_parallel_rows(th, rows, atrous_rows, &c);
         for (int k = 0; k < (split ? 2 : 1); ++k) src[k] = dst[k], vsrc[k] = vdst[k];
     }
