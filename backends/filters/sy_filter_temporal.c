@@ -57,7 +57,7 @@ static inline SY_TEMPORAL_INLINE float expneg(float x, float xmax)
 }
 
 /* One frame's history: what the next frame reprojects. Planes of w*h floats, plane q of a group at
- * base + q*w*h. */
+ * base + q*stride (plane_stride). */
 typedef struct hist {
     uint32_t w, h;
     size_t stride; /* floats from one plane to the next (plane_stride of w*h) */
@@ -866,15 +866,16 @@ static void atrous_rows(void *vc, uint32_t y0, uint32_t y1)
                 int yy = y + (r - 1) * s;
                 bool in = yy >= 0 && yy < hgt;
                 size_t o = in ? (size_t)yy * w : 0;
-                const float *src[13] = {cls,   Z,         N0,            N1,    N2,    PC[0],        PC[0] + n,
-                                        PC[0] + 2 * n, PV[0], PC[1],    PC[1] + n, PC[1] + 2 * n, PV[1]};
+                const float *src[13] = {cls,   Z,     N0,        N1,            N2,   /* the guides */
+                                        PC[0], PC[0] + n, PC[0] + 2 * n, PV[0], /* part 0 */
+                                        PC[1], PC[1] + n, PC[1] + 2 * n, PV[1]}; /* part 1 */
                 for (int q = 0; q < 5 + 4 * parts; ++q) P[q][r] = in ? src[q] + o : (q == 0 ? neg : zero);
             }
             float *o0 = PD[0] + row, *o1 = PD[0] + n + row, *o2 = PD[0] + 2 * n + row, *ov = PDV[0] + row;
             /* what a chunk reads at its own columns (the centre's planes and the outputs), and at
              * its columns shifted by -s, 0, +s (the 5 + 4 x parts neighbour planes' 3 rows) */
-            const float *PM[12] = {SN + row, IZ + row, PIL[0] + row, o0,           o1,          o2,
-                                   ov,       PIL[1] + row, PD[1] + row, PD[1] + n + row, PD[1] + 2 * n + row, PDV[1] + row};
+            const float *PM[12] = {SN + row, IZ + row, PIL[0] + row, o0, o1, o2, ov, /* part 0 */
+                                   PIL[1] + row, PD[1] + row, PD[1] + n + row, PD[1] + 2 * n + row, PDV[1] + row};
             const float *PN[39];
             int nm = parts == 2 ? 12 : 7, nn = 0;
             for (int q = 0; q < 5 + 4 * parts; ++q)
