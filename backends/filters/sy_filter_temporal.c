@@ -336,10 +336,11 @@ static inline SY_TEMPORAL_INLINE float nonfinite0(float x)
     return x * 0.0f;
 }
 
-/* luminance (Rec. 709) of a colour: the a-trous passes' luminance edge stop. The passes keep no
- * luminance planes: each tap computes it from the colour it loads anyway (the same expression as
- * the blend's and the passes' results would have stored, so the same values): 6 fewer planes in
- * memory, 8 fewer streams a pass. */
+/* luminance (Rec. 709) of a colour: sy_filter_luminance's expression on three separate channels
+ * (plane values; always inlined into the vectorised clones), for the demodulation and the a-trous
+ * passes' luminance edge stop. The passes keep no luminance planes: each tap computes it from the
+ * colour it loads anyway (the same expression as the blend's and the passes' results would have
+ * stored, so the same values): 6 fewer planes in memory, 8 fewer streams a pass. */
 static inline SY_TEMPORAL_INLINE float lum3(float r, float g, float b)
 {
     return 0.2126f * r + 0.7152f * g + 0.0722f * b;
@@ -386,13 +387,13 @@ static inline SY_TEMPORAL_INLINE float lum3(float r, float g, float b)
         float x0 = split ? ind[3 * i] : cl[0], x1 = split ? ind[3 * i + 1] : cl[1], x2 = split ? ind[3 * i + 2] : cl[2];\
         float r0 = okf > 0.0f ? x0 / ma : 0.0f, r1 = okf > 0.0f ? x1 / mb : 0.0f, r2 = okf > 0.0f ? x2 / mc : 0.0f;   \
         c0[i] = r0, c1[i] = r1, c2[i] = r2;                                                                           \
-        l0[i] = 0.2126f * r0 + 0.7152f * r1 + 0.0722f * r2;                                                           \
+        l0[i] = lum3(r0, r1, r2);                                                                                     \
         float e0 = 0.0f, e1 = 0.0f, e2 = 0.0f;                                                                        \
         if (split)                                                                                                    \
             e0 = okf > 0.0f ? dir[3 * i] / ma : 0.0f, e1 = okf > 0.0f ? dir[3 * i + 1] / mb : 0.0f,                   \
             e2 = okf > 0.0f ? dir[3 * i + 2] / mc : 0.0f;                                                             \
         d0[i] = e0, d1[i] = e1, d2[i] = e2;                                                                           \
-        l1[i] = 0.2126f * e0 + 0.7152f * e1 + 0.0722f * e2;                                                           \
+        l1[i] = lum3(e0, e1, e2);                                                                                     \
     }                                                                                                                 \
     }
 SY_DEMOD_VARIANT(demod_c3, 3, false)
