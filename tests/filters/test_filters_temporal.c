@@ -139,8 +139,8 @@ static int test_constant_pan(void)
         if (k > 0) CHECK_MSG(st.reprojected > st.pixels * 8 / 10, "frame %d: %llu of %llu reprojected", k,
                              (unsigned long long)st.reprojected, (unsigned long long)st.pixels);
     }
-    printf("constant wall, 8-frame pan (one at half size, one at 5x): max |out - 0.3| = %.2e, mean history %.1f\n", maxd,
-           st.mean_history);
+    printf("constant wall, 8-frame pan (one at half size, one at 5x): max |out - 0.3| = %.2e, mean history %.1f\n",
+           maxd, st.mean_history);
     CHECK(maxd < 1e-5);
     CHECK(st.mean_history > 4.0);
     return temporal_close(t, &s);
