@@ -4,6 +4,16 @@
 
 static void build_tables(sy_rt_sobol *s);
 
+/* the first step of a set's per-pixel seed (sy_rt_sobol.set_hash) */
+static inline uint32_t set_hash(uint32_t set)
+{
+    return sy_rt_hash32(set * 0x9e3779b9u + 0x632be5abu);
+}
+static inline uint32_t set_hash_at(const sy_rt_sobol *s, uint32_t set)
+{
+    return set < SY_RT_SOBOL_SETS ? s->set_hash[set] : set_hash(set);
+}
+
 void sy_rt_sobol_init(sy_rt_sobol *s)
 {
     /* Joe-Kuo new-joe-kuo-6.21201, dimensions 2..4 (s, a, m); dimension 1 is van der Corput. */
@@ -24,6 +34,7 @@ void sy_rt_sobol_init(sy_rt_sobol *s)
         }
     }
     build_tables(s);
+    for (uint32_t set = 0; set < SY_RT_SOBOL_SETS; ++set) s->set_hash[set] = set_hash(set);
 }
 
 uint32_t sy_rt_sobol_raw(const sy_rt_sobol *s, uint32_t index, uint32_t dim)
@@ -99,7 +110,7 @@ static inline sy_u32x4 reverse_bits4(sy_u32x4 x)
 SY_RT_SAMPLE4_CLONES
 void sy_rt_sobol_sample4(const sy_rt_sobol *s, uint32_t pixel_seed, uint32_t set, uint32_t index, float out[4])
 {
-    uint32_t seed = sy_rt_hash32(pixel_seed ^ sy_rt_hash32(set * 0x9e3779b9u + 0x632be5abu));
+    uint32_t seed = sy_rt_hash32(pixel_seed ^ set_hash_at(s, set));
     uint32_t j = laine_karras(reverse_bits(index), seed);
     uint32_t j0 = j & 0xffu, j1 = (j >> 8) & 0xffu, j2 = (j >> 16) & 0xffu, j3 = j >> 24;
     sy_u32x4 h = {seed, seed + 0x68e31da4u, seed + 2u * 0x68e31da4u, seed + 3u * 0x68e31da4u};
@@ -118,7 +129,7 @@ void sy_rt_sobol_sample4(const sy_rt_sobol *s, uint32_t pixel_seed, uint32_t set
 #else
 void sy_rt_sobol_sample4(const sy_rt_sobol *s, uint32_t pixel_seed, uint32_t set, uint32_t index, float out[4])
 {
-    uint32_t seed = sy_rt_hash32(pixel_seed ^ sy_rt_hash32(set * 0x9e3779b9u + 0x632be5abu));
+    uint32_t seed = sy_rt_hash32(pixel_seed ^ set_hash_at(s, set));
     uint32_t j = laine_karras(reverse_bits(index), seed);
     for (uint32_t d = 0; d < 4; ++d) {
         uint32_t rr = s->t[0][j & 0xffu][d] ^ s->t[1][(j >> 8) & 0xffu][d] ^ s->t[2][(j >> 16) & 0xffu][d] ^ s->t[3][j >> 24][d];

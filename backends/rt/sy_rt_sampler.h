@@ -9,11 +9,17 @@
 
 #include <stdint.h>
 
+/* sets whose seed hash is a table look-up (the path tracer's sets reach 2 + 2 x max_depth) */
+enum { SY_RT_SOBOL_SETS = 1024 };
+
 typedef struct sy_rt_sobol {
     uint32_t v[4][32];       /* direction numbers of dimensions 0..3 */
     /* per byte b of the scrambled, bit-reversed index and its value x: the XOR of the byte's direction
      * numbers, bit-reversed, of the four dimensions side by side (one 16-byte load per byte) */
     _Alignas(16) uint32_t t[4][256][4];
+    /* the hash of each set below SY_RT_SOBOL_SETS (the per-pixel seed's first step: the same for
+     * every pixel, so looked up, not computed, on the path's dependency chain) */
+    uint32_t set_hash[SY_RT_SOBOL_SETS];
 } sy_rt_sobol;
 
 void sy_rt_sobol_init(sy_rt_sobol *s);
