@@ -24,7 +24,9 @@ static uint32_t rev(uint32_t x)
     return r;
 }
 
-/* Burley's Laine-Karras permutation (JCGT 2020, listing 2's improved constants) */
+/* Burley's Laine-Karras permutation (JCGT 2020, listing 2's improved constants), written out again
+ * from the paper on purpose (the sampler's own is static there): the test's oracle must not share
+ * the code it checks, or a wrong constant in the sampler would pass */
 static uint32_t lk(uint32_t x, uint32_t seed)
 {
     x ^= x * 0x3d20adeau;
