@@ -129,6 +129,77 @@ float sy_rt_lighttree_importance(const sy_rt_lt_bounds *b, sy_rt_v3 p, sy_rt_v3 
     return isfinite(w) && w > 0.0f ? w : 0.0f;
 }
 
+_Static_assert(SY_RT_LT_LEAF_MAX <= 4u, "leaf_probs takes a leaf's importances in one sy_rt_lighttree_importance4");
+
+#if defined(__GNUC__)
+/* The scalar function's branches are masks here: every lane computes every term. */
+typedef float lt_f4 __attribute__((vector_size(16)));
+typedef int32_t lt_i4 __attribute__((vector_size(16)));
+static inline lt_f4 f4_sel(lt_i4 m, lt_f4 a, lt_f4 b) { return (lt_f4)((m & (lt_i4)a) | (~m & (lt_i4)b)); }
+static inline lt_f4 f4_sqrt(lt_f4 x)
+{
+#if defined(__SSE__)
+    return __builtin_ia32_sqrtps(x);
+#else
+    return (lt_f4){sqrtf(x[0]), sqrtf(x[1]), sqrtf(x[2]), sqrtf(x[3])};
+#endif
+}
+static inline lt_f4 f4_max0(lt_f4 x) { return f4_sel(x > 0.0f, x, (lt_f4){0}); } /* fmaxf(0, x) */
+
+void sy_rt_lighttree_importance4(const sy_rt_lt_bounds *const b[4], sy_rt_v3 p, sy_rt_v3 n, float out[4])
+{
+    lt_f4 lx, ly, lz, hx, hy, hz, ax, ay, az, to, co, so, ce_b, pw;
+    for (int i = 0; i < 4; ++i) {
+        lx[i] = b[i]->lo[0], ly[i] = b[i]->lo[1], lz[i] = b[i]->lo[2];
+        hx[i] = b[i]->hi[0], hy[i] = b[i]->hi[1], hz[i] = b[i]->hi[2];
+        ax[i] = b[i]->axis[0], ay[i] = b[i]->axis[1], az[i] = b[i]->axis[2];
+        to[i] = b[i]->theta_o, co[i] = b[i]->cos_o, so[i] = b[i]->sin_o, ce_b[i] = b[i]->cos_e, pw[i] = b[i]->power;
+    }
+    const lt_f4 one = {1.0f, 1.0f, 1.0f, 1.0f}, zero = {0};
+    lt_f4 vx = p.x - (lx + hx) * 0.5f, vy = p.y - (ly + hy) * 0.5f, vz = p.z - (lz + hz) * 0.5f;
+    lt_f4 ex = hx - lx, ey = hy - ly, ez = hz - lz;
+    lt_f4 d2 = vx * vx + vy * vy + vz * vz, r2 = 0.25f * (ex * ex + ey * ey + ez * ez);
+    lt_i4 inside = (p.x >= lx) & (p.x <= hx) & (p.y >= ly) & (p.y <= hy) & (p.z >= lz) & (p.z <= hz);
+    lt_i4 far = ~inside & (d2 > r2);
+    lt_f4 inv_d = one / f4_sqrt(d2);
+    lt_f4 wx = vx * inv_d, wy = vy * inv_d, wz = vz * inv_d;
+    lt_f4 su = f4_sqrt(r2) * inv_d;
+    su = f4_sel(su < 1.0f, su, one);
+    lt_f4 cu = f4_sqrt(f4_max0(1.0f - su * su));
+    /* emission */
+    lt_f4 ct = ax * wx + ay * wy + az * wz;
+    ct = f4_sel(ct < -1.0f, -one, f4_sel(ct > 1.0f, one, ct));
+    lt_f4 st = f4_sqrt(f4_max0(1.0f - ct * ct));
+    lt_f4 c1 = ct * co + st * so, s1 = st * co - ct * so;
+    lt_f4 c2e = c1 * cu + s1 * su;
+    lt_i4 bend_e = far & (to < PI_F) & (ct < co) & (c1 < cu);
+    lt_i4 zero_w = bend_e & ((c2e <= ce_b) | (c2e <= 0.0f));
+    lt_f4 ce = f4_sel(bend_e, c2e, one);
+    /* the surface */
+    lt_f4 ci = one;
+    if (!v3_is_zero(n)) {
+        lt_f4 cti = -(n.x * wx + n.y * wy + n.z * wz);
+        cti = f4_sel(cti < -1.0f, -one, f4_sel(cti > 1.0f, one, cti));
+        lt_f4 sti = f4_sqrt(f4_max0(1.0f - cti * cti));
+        lt_f4 c2i = cti * cu + sti * su;
+        lt_i4 bend_i = far & (cti < cu);
+        zero_w |= bend_i & (c2i <= 0.0f);
+        ci = f4_sel(bend_i, c2i, one);
+    }
+    lt_f4 dc = f4_sel(d2 > r2, d2, r2);
+    dc = f4_sel(dc > 1e-12f, dc, (lt_f4){1e-12f, 1e-12f, 1e-12f, 1e-12f});
+    lt_f4 w = pw * ce * ci / dc;
+    lt_i4 ok = ~zero_w & (w - w == zero) & (w > 0.0f); /* finite and positive */
+    w = f4_sel(ok, w, zero);
+    for (int i = 0; i < 4; ++i) out[i] = w[i];
+}
+#else
+void sy_rt_lighttree_importance4(const sy_rt_lt_bounds *const b[4], sy_rt_v3 p, sy_rt_v3 n, float out[4])
+{
+    for (int i = 0; i < 4; ++i) out[i] = sy_rt_lighttree_importance(b[i], p, n);
+}
+#endif
+
 static float distant_importance(const sy_rt_lt_bounds *b, sy_rt_v3 n)
 {
     if (v3_is_zero(n)) return b->power;
@@ -493,22 +564,52 @@ static float top_prob(const sy_rt_lighttree *t, sy_rt_v3 p, sy_rt_v3 n, uint32_t
     return 0.0f;
 }
 
-static void inner_probs(const sy_rt_lighttree *t, const sy_rt_lt_node *nd, sy_rt_v3 p, sy_rt_v3 n, float pr[2])
+/* Choices a walk's step weighs at most (a power of two): 4 = a node's grandchildren, two levels
+ * down (8, three levels, measured no better: docs/BACKENDS.md "Many lights"). */
+#define LT_STEP_MAX 4u
+
+/* A step of the walk from inner node nd: its descendants as far down as every one is an inner
+ * node, at most LT_STEP_MAX of them (nd's two children; where both are inner, its four
+ * grandchildren; and so on), in left-to-right order into node[], with their probabilities
+ * (importances, four a sy_rt_lighttree_importance4) into pr[]. Returns their number and in
+ * *levels how far down they are. A step over two levels weighs each choice by its own, finer
+ * bounds (the binary walk weighed the children's coarser ones first) and halves the dependent
+ * steps of a walk. pick and pdf step alike. */
+static uint32_t step_choices(const sy_rt_lighttree *t, const sy_rt_lt_node *nd, sy_rt_v3 p, sy_rt_v3 n,
+                             uint32_t node[LT_STEP_MAX], float pr[LT_STEP_MAX], uint32_t *levels)
 {
-    const sy_rt_lt_node *l = &t->nodes[nd->child], *r = l + 1;
-    float pw[2] = {l->b.power, r->b.power};
-    pr[0] = sy_rt_lighttree_importance(&l->b, p, n);
-    pr[1] = sy_rt_lighttree_importance(&r->b, p, n);
-    choice_probs(pr, pw, 2u);
+    uint32_t k = 2u;
+    node[0] = nd->child, node[1] = nd->child + 1u;
+    *levels = 1u;
+    while (2u * k <= LT_STEP_MAX) {
+        bool inner = true;
+        for (uint32_t i = 0; i < k; ++i) inner = inner && !t->nodes[node[i]].count;
+        if (!inner) break;
+        for (uint32_t i = k; i-- > 0;) { /* in place, from the end: node[i] is read before 2i, 2i + 1 are written */
+            uint32_t c = t->nodes[node[i]].child;
+            node[2u * i] = c, node[2u * i + 1u] = c + 1u;
+        }
+        k *= 2u, ++*levels;
+    }
+    float pw[LT_STEP_MAX];
+    for (uint32_t i = 0; i < k; i += 4u) {
+        const sy_rt_lt_bounds *b[4];
+        for (uint32_t j = 0; j < 4u; ++j) b[j] = &t->nodes[node[i + j < k ? i + j : i]].b;
+        float w[4];
+        sy_rt_lighttree_importance4(b, p, n, w);
+        for (uint32_t j = 0; j < 4u && i + j < k; ++j) pr[i + j] = w[j], pw[i + j] = b[j]->power;
+    }
+    choice_probs(pr, pw, k);
+    return k;
 }
 
 static void leaf_probs(const sy_rt_lighttree *t, const sy_rt_lt_node *nd, sy_rt_v3 p, sy_rt_v3 n, float *pr)
 {
-    float pw[SY_RT_LT_LEAF_MAX];
-    for (uint32_t i = 0; i < nd->count; ++i) {
-        pw[i] = t->prims[nd->child + i].power;
-        pr[i] = sy_rt_lighttree_importance(&t->prims[nd->child + i], p, n);
-    }
+    float pw[SY_RT_LT_LEAF_MAX], w[4];
+    const sy_rt_lt_bounds *b[4];
+    for (uint32_t i = 0; i < 4u; ++i) b[i] = &t->prims[nd->child + (i < nd->count ? i : 0u)];
+    sy_rt_lighttree_importance4(b, p, n, w);
+    for (uint32_t i = 0; i < nd->count; ++i) pw[i] = t->prims[nd->child + i].power, pr[i] = w[i];
     choice_probs(pr, pw, nd->count);
 }
 
@@ -525,11 +626,12 @@ uint32_t sy_rt_lighttree_pick(const sy_rt_lighttree *t, sy_rt_v3 p, sy_rt_v3 n, 
     }
     const sy_rt_lt_node *nd = t->nodes;
     while (!nd->count) {
-        float pr[2];
-        inner_probs(t, nd, p, n, pr);
-        uint32_t c = choose(pr, 2u, &u);
+        uint32_t node[LT_STEP_MAX], levels;
+        float pr[LT_STEP_MAX];
+        uint32_t k = step_choices(t, nd, p, n, node, pr, &levels);
+        uint32_t c = choose(pr, k, &u);
         prob *= pr[c];
-        nd = &t->nodes[nd->child + c];
+        nd = &t->nodes[node[c]];
     }
     float pr[SY_RT_LT_LEAF_MAX];
     leaf_probs(t, nd, p, n, pr);
@@ -549,11 +651,18 @@ float sy_rt_lighttree_pdf(const sy_rt_lighttree *t, sy_rt_v3 p, sy_rt_v3 n, uint
     /* the path from the root, then the same products in the same order as pick */
     uint32_t path[LT_MAX_DEPTH + 1u], depth = 0;
     for (uint32_t x = t->prim_leaf[k]; x != SY_RT_LT_NONE && depth <= LT_MAX_DEPTH; x = t->nodes[x].parent) path[depth++] = x;
+    if (!depth) return 0.0f;
     float prob = top_prob(t, p, n, 0, NULL, NULL);
-    for (uint32_t d = depth; d-- > 1u;) {
-        float pr[2];
-        inner_probs(t, &t->nodes[path[d]], p, n, pr);
-        prob *= pr[path[d - 1u] - t->nodes[path[d]].child];
+    for (uint32_t d = depth - 1u; d > 0u;) { /* path[d]: the node the walk is at */
+        uint32_t node[LT_STEP_MAX], levels;
+        float pr[LT_STEP_MAX];
+        uint32_t k = step_choices(t, &t->nodes[path[d]], p, n, node, pr, &levels);
+        if (levels > d) return 0.0f; /* (a path that ends on an inner node: not in a built tree) */
+        uint32_t c = 0;
+        while (c < k && node[c] != path[d - levels]) ++c;
+        if (c == k) return 0.0f; /* (not below it: not in a built tree) */
+        prob *= pr[c];
+        d -= levels;
     }
     const sy_rt_lt_node *leaf = &t->nodes[path[0]];
     float pr[SY_RT_LT_LEAF_MAX];

@@ -4,6 +4,8 @@
  *     lights, two directional lights, and degenerate ones: zero, negative and NaN power, a NaN
  *     box), the pdfs of all lights sum to 1 (within 1e-3) at 64 random shading points with and
  *     without a normal; left-out lights have pdf 0 and are counted;
+ *   - sy_rt_lighttree_importance4 equals the scalar importance bit for bit, lane by lane, for a
+ *     built tree's nodes and lights from points outside and inside their boxes;
  *   - counting: over 60 lights, 2^18 stratified picks at each of 8 points choose every light as
  *     often as its pdf says (within 0.002 absolute), and every pick's pdf equals
  *     sy_rt_lighttree_pdf of its light exactly;
@@ -90,6 +92,49 @@ static void test_pdf_sums(void)
     /* a light that becomes degenerate needs a rebuild */
     l[101].b.power = 0.0f;
     EXPECT_MSG(!sy_rt_lighttree_refit(&t, l, n, &changed), "refit refuses a light that left the set");
+    sy_rt_lighttree_free(&t);
+    free(l);
+}
+
+/* sy_rt_lighttree_importance4 (the walk's steps) gives each lane the scalar function's value bit
+ * for bit (the root's step and the tests' reference), for the nodes and lights of a built tree
+ * (their cosines filled by the build), from points outside, on and inside their boxes, with and
+ * without a surface normal. */
+static void test_importance4_exact(void)
+{
+    const uint32_t n = 3000;
+    sy_rt_lt_light *l = malloc(n * sizeof *l);
+    for (uint32_t i = 0; i < n; ++i) random_light(&l[i], i);
+    sy_rt_lighttree t;
+    bool oom;
+    EXPECT_MSG(sy_rt_lighttree_build(&t, l, n, 0, &oom), "build of %u lights", n);
+    uint32_t total = t.node_count + n, compared = 0, differ = 0, nonzero = 0;
+    for (int k = 0; k < 48; ++k) {
+        sy_rt_v3 nrm = k % 3 == 0 ? v3(0, 0, 0) : v3_normalize(v3(frand() - 0.5f, frand() - 0.5f, frand() - 0.5f));
+        sy_rt_v3 pk = random_point();
+        for (uint32_t i = 0; i + 4u <= total; i += 4u) {
+            const sy_rt_lt_bounds *b[4];
+            for (uint32_t j = 0; j < 4u; ++j)
+                b[j] = i + j < t.node_count ? &t.nodes[i + j].b : &t.prims[i + j - t.node_count];
+            /* every third group from the centre of its first box (inside it, or on a flat one) */
+            sy_rt_v3 p = k % 4 == 3 ? v3(0.5f * (b[0]->lo[0] + b[0]->hi[0]), 0.5f * (b[0]->lo[1] + b[0]->hi[1]),
+                                         0.5f * (b[0]->lo[2] + b[0]->hi[2]))
+                                    : pk;
+            float w[4];
+            sy_rt_lighttree_importance4(b, p, nrm, w);
+            for (uint32_t j = 0; j < 4u; ++j) {
+                float s1 = sy_rt_lighttree_importance(b[j], p, nrm);
+                compared++;
+                if (memcmp(&s1, &w[j], sizeof s1) != 0) {
+                    if (differ++ < 5u) fprintf(stderr, "  lane %u: %.9g, scalar %.9g\n", j, (double)w[j], (double)s1);
+                }
+                nonzero += s1 > 0.0f;
+            }
+        }
+    }
+    EXPECT_MSG(differ == 0u, "importance4 equals the scalar importance bit for bit (%u of %u differ)", differ, compared);
+    EXPECT_MSG(nonzero > compared / 4u && nonzero < compared, "both zero and positive importances compared (%u of %u positive)",
+               nonzero, compared);
     sy_rt_lighttree_free(&t);
     free(l);
 }
@@ -310,6 +355,7 @@ static void test_auto_is_off_with_few_lights(void)
 int main(void)
 {
     test_pdf_sums();
+    test_importance4_exact();
     test_counting();
     test_million();
     test_render_converges();
