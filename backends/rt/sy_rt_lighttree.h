@@ -8,8 +8,8 @@
  * emission cosine x the box-bounded surface cosine / the clamped squared distance) among a node's
  * four grandchildren where both its children are inner nodes, else among its two children, and
  * in a leaf (up to SY_RT_LT_LEAF_MAX lights) a light the same way. (Weighing the grandchildren by
- * their own, finer bounds instead of the children's first: 3x less error on `sy bench lights`, the
- * rare picks with huge weights gone; docs/BACKENDS.md "Many lights".) Directional lights have no position: they
+ * their own, finer bounds instead of the children's first: relMSE 0.058 -> 0.040 at equal time on
+ * `sy bench lights`, the rare picks with huge weights gone; docs/BACKENDS.md "Many lights".) Directional lights have no position: they
  * stand beside the root, each with importance = its irradiance x the bounded surface cosine. The
  * probability of the chosen light is the product of the choices; sy_rt_lighttree_pdf recomputes
  * it for any light (each light keeps its leaf, every node its parent), so that a light hit by a
