@@ -24,6 +24,11 @@ static bool bounds_valid(const sy_rt_lt_bounds *b, bool distant)
     return isfinite(b->theta_o) && isfinite(b->theta_e);
 }
 
+/* Whether light l goes into the tree (or beside its root). */
+static bool light_kept(const sy_rt_lt_light *l) { return !l->dark && bounds_valid(&l->b, l->distant); }
+/* Whether a kept light stands beside the root. */
+static bool light_at_top(const sy_rt_lt_light *l) { return l->distant || l->top; }
+
 /* Conty & Kulla 2018, algorithm 1: the smallest cone (of the two's form) holding both. */
 static void cone_union(sy_rt_lt_bounds *out, const sy_rt_lt_bounds *a, const sy_rt_lt_bounds *b)
 {
@@ -306,9 +311,10 @@ void sy_rt_lighttree_free(sy_rt_lighttree *t)
     free(t->prim_light);
     free(t->prim_leaf);
     free(t->light_prim);
-    free(t->distant);
-    free(t->distant_b);
-    free(t->light_distant);
+    free(t->top);
+    free(t->top_b);
+    free(t->top_local);
+    free(t->light_top);
     tree_reset(t);
 }
 
@@ -329,11 +335,11 @@ bool sy_rt_lighttree_build(sy_rt_lighttree *t, const sy_rt_lt_light *lights, uin
 {
     tree_reset(t);
     *oom = false;
-    uint32_t m = 0, nd = 0;
+    uint32_t m = 0, nd = 0; /* lights in the tree, beside its root */
     for (uint32_t i = 0; i < n; ++i) {
-        if (!bounds_valid(&lights[i].b, lights[i].distant)) {
-            if (t->skipped++ == 0) t->first_skipped = i;
-        } else if (lights[i].distant) {
+        if (!light_kept(&lights[i])) {
+            if (!lights[i].dark && t->skipped++ == 0) t->first_skipped = i;
+        } else if (light_at_top(&lights[i])) {
             nd++;
         } else {
             m++;
@@ -343,7 +349,8 @@ bool sy_rt_lighttree_build(sy_rt_lighttree *t, const sy_rt_lt_light *lights, uin
     /* what the tree will hold, nodes at their bound (2m - 1) */
     size_t est = (size_t)n * sizeof(uint32_t) + (size_t)m * (sizeof(sy_rt_lt_bounds) + 2u * sizeof(uint32_t)) +
                  (size_t)(m ? 2u * m - 1u : 0u) * sizeof(sy_rt_lt_node) +
-                 (size_t)nd * (sizeof(uint32_t) + sizeof(sy_rt_lt_bounds)) + (nd ? (size_t)n * sizeof(uint32_t) : 0u);
+                 (size_t)nd * (sizeof(uint32_t) + sizeof(sy_rt_lt_bounds) + sizeof(bool)) +
+                 (nd ? (size_t)n * sizeof(uint32_t) : 0u);
     if (max_bytes && est > max_bytes) {
         uint32_t skipped = t->skipped, first = t->first_skipped;
         tree_reset(t);
@@ -356,13 +363,14 @@ bool sy_rt_lighttree_build(sy_rt_lighttree *t, const sy_rt_lt_light *lights, uin
     t->prim_leaf = malloc((size_t)m * sizeof *t->prim_leaf + 1u);
     t->nodes = malloc((size_t)(m ? 2u * m - 1u : 1u) * sizeof *t->nodes);
     if (nd) {
-        t->distant = malloc((size_t)nd * sizeof *t->distant);
-        t->distant_b = malloc((size_t)nd * sizeof *t->distant_b);
-        t->light_distant = malloc((size_t)n * sizeof *t->light_distant);
+        t->top = malloc((size_t)nd * sizeof *t->top);
+        t->top_b = malloc((size_t)nd * sizeof *t->top_b);
+        t->top_local = malloc((size_t)nd * sizeof *t->top_local);
+        t->light_top = malloc((size_t)n * sizeof *t->light_top);
     }
     build_task *stack = malloc((LT_MAX_DEPTH + 2u) * sizeof *stack);
     if (!t->light_prim || !t->prims || !t->prim_light || !t->prim_leaf || !t->nodes || !stack ||
-        (nd && (!t->distant || !t->distant_b || !t->light_distant))) {
+        (nd && (!t->top || !t->top_b || !t->top_local || !t->light_top))) {
         free(stack);
         sy_rt_lighttree_free(t);
         *oom = true;
@@ -371,13 +379,14 @@ bool sy_rt_lighttree_build(sy_rt_lighttree *t, const sy_rt_lt_light *lights, uin
     uint32_t *refs = t->prim_light; /* partitioned in place: ends in leaf order */
     for (uint32_t i = 0; i < n; ++i) {
         t->light_prim[i] = SY_RT_LT_NONE;
-        if (nd) t->light_distant[i] = SY_RT_LT_NONE;
-        if (!bounds_valid(&lights[i].b, lights[i].distant)) continue;
-        if (lights[i].distant) {
-            t->light_distant[i] = t->distant_count;
-            t->distant_b[t->distant_count] = lights[i].b;
-            bounds_finish(&t->distant_b[t->distant_count]);
-            t->distant[t->distant_count++] = i;
+        if (nd) t->light_top[i] = SY_RT_LT_NONE;
+        if (!light_kept(&lights[i])) continue;
+        if (light_at_top(&lights[i])) {
+            t->light_top[i] = t->top_count;
+            t->top_local[t->top_count] = !lights[i].distant;
+            t->top_b[t->top_count] = lights[i].b;
+            bounds_finish(&t->top_b[t->top_count]);
+            t->top[t->top_count++] = i;
         } else {
             refs[t->prim_count++] = i;
         }
@@ -444,7 +453,8 @@ bool sy_rt_lighttree_build(sy_rt_lighttree *t, const sy_rt_lt_light *lights, uin
     }
     free(stack);
     t->bytes = (size_t)n * sizeof(uint32_t) * (nd ? 2u : 1u) + (size_t)m * (sizeof(sy_rt_lt_bounds) + 2u * sizeof(uint32_t)) +
-               (size_t)t->node_count * sizeof(sy_rt_lt_node) + (size_t)nd * (sizeof(uint32_t) + sizeof(sy_rt_lt_bounds));
+               (size_t)t->node_count * sizeof(sy_rt_lt_node) +
+               (size_t)nd * (sizeof(uint32_t) + sizeof(sy_rt_lt_bounds) + sizeof(bool));
     return true;
 }
 
@@ -453,18 +463,19 @@ bool sy_rt_lighttree_refit(sy_rt_lighttree *t, const sy_rt_lt_light *lights, uin
     *changed = 0;
     if (n != t->light_count) return false;
     for (uint32_t i = 0; i < n; ++i) { /* the same lights in the same places, or a rebuild */
-        bool valid = bounds_valid(&lights[i].b, lights[i].distant);
-        bool in_tree = t->light_prim[i] != SY_RT_LT_NONE, in_distant = t->light_distant && t->light_distant[i] != SY_RT_LT_NONE;
-        if (valid != (in_tree || in_distant)) return false;
-        if (valid && lights[i].distant != in_distant) return false;
+        bool valid = light_kept(&lights[i]);
+        bool in_tree = t->light_prim[i] != SY_RT_LT_NONE, in_top = t->light_top && t->light_top[i] != SY_RT_LT_NONE;
+        if (valid != (in_tree || in_top)) return false;
+        if (valid && light_at_top(&lights[i]) != in_top) return false;
+        if (valid && in_top && t->top_local[t->light_top[i]] == lights[i].distant) return false;
     }
     uint32_t differ = 0, limit = n / 64u + 1u;
     for (uint32_t i = 0; i < n && differ <= limit; ++i) {
         uint32_t k = t->light_prim[i];
         sy_rt_lt_bounds b = lights[i].b;
         bounds_finish(&b);
-        if (t->light_distant && t->light_distant[i] != SY_RT_LT_NONE)
-            differ += memcmp(&t->distant_b[t->light_distant[i]], &b, sizeof b) != 0;
+        if (t->light_top && t->light_top[i] != SY_RT_LT_NONE)
+            differ += memcmp(&t->top_b[t->light_top[i]], &b, sizeof b) != 0;
         else if (k != SY_RT_LT_NONE)
             differ += memcmp(&t->prims[k], &b, sizeof b) != 0;
     }
@@ -472,8 +483,8 @@ bool sy_rt_lighttree_refit(sy_rt_lighttree *t, const sy_rt_lt_light *lights, uin
     for (uint32_t i = 0; i < n; ++i) {
         sy_rt_lt_bounds b = lights[i].b;
         bounds_finish(&b);
-        if (t->light_distant && t->light_distant[i] != SY_RT_LT_NONE) {
-            sy_rt_lt_bounds *d = &t->distant_b[t->light_distant[i]];
+        if (t->light_top && t->light_top[i] != SY_RT_LT_NONE) {
+            sy_rt_lt_bounds *d = &t->top_b[t->light_top[i]];
             if (memcmp(d, &b, sizeof *d)) *d = b, (*changed)++;
             continue;
         }
@@ -518,25 +529,35 @@ static uint32_t choose(const float *p, uint32_t k, float *u)
     return last;
 }
 
-/* The top level: the root (when there is a tree) then the directional lights. Only 1 + 3 entries
- * at most are kept on the stack; beyond that the directional lights are scanned. */
+/* The importance of top entry i (0: the root when there is a tree) at (p, n). */
+static float top_importance(const sy_rt_lighttree *t, uint32_t i, sy_rt_v3 p, sy_rt_v3 n)
+{
+    if (t->node_count && i == 0) return sy_rt_lighttree_importance(&t->nodes[0].b, p, n);
+    uint32_t k = i - (t->node_count ? 1u : 0u);
+    return t->top_local[k] ? sy_rt_lighttree_importance(&t->top_b[k], p, n) : distant_importance(&t->top_b[k], n);
+}
+
+/* The top level: the root (when there is a tree), then the lights beside it (directional ones and
+ * local ones marked top), each in proportion to its importance (by power where none has any).
+ * With u: chooses one (*chosen, u rescaled) and returns its probability; else returns entry
+ * which's probability. */
 static float top_prob(const sy_rt_lighttree *t, sy_rt_v3 p, sy_rt_v3 n, uint32_t which, float *u, uint32_t *chosen)
 {
     /* weights, summed in a fixed order: pick and pdf agree */
     float s = 0.0f, ps = 0.0f;
-    uint32_t k = (t->node_count ? 1u : 0u) + t->distant_count;
+    uint32_t k = (t->node_count ? 1u : 0u) + t->top_count;
     for (uint32_t i = 0; i < k; ++i) {
         bool root = t->node_count && i == 0;
-        const sy_rt_lt_bounds *b = root ? &t->nodes[0].b : &t->distant_b[i - (t->node_count ? 1u : 0u)];
-        s += root ? sy_rt_lighttree_importance(b, p, n) : distant_importance(b, n);
+        const sy_rt_lt_bounds *b = root ? &t->nodes[0].b : &t->top_b[i - (t->node_count ? 1u : 0u)];
+        s += top_importance(t, i, p, n);
         ps += b->power;
     }
     bool by_power = !(s > 0.0f) || !isfinite(s);
     float total = by_power ? ps : s, acc = 0.0f;
     for (uint32_t i = 0; i < k; ++i) {
         bool root = t->node_count && i == 0;
-        const sy_rt_lt_bounds *b = root ? &t->nodes[0].b : &t->distant_b[i - (t->node_count ? 1u : 0u)];
-        float w = by_power ? b->power : (root ? sy_rt_lighttree_importance(b, p, n) : distant_importance(b, n));
+        const sy_rt_lt_bounds *b = root ? &t->nodes[0].b : &t->top_b[i - (t->node_count ? 1u : 0u)];
+        float w = by_power ? b->power : top_importance(t, i, p, n);
         float pr = w / total;
         if (u) {
             if (pr > 0.0f && (*u < acc + pr || i + 1u == k)) {
@@ -552,8 +573,8 @@ static float top_prob(const sy_rt_lighttree *t, sy_rt_v3 p, sy_rt_v3 n, uint32_t
     if (u) { /* rounding left u past the last nonzero entry */
         for (uint32_t i = k; i-- > 0;) {
             bool root = t->node_count && i == 0;
-            const sy_rt_lt_bounds *b = root ? &t->nodes[0].b : &t->distant_b[i - (t->node_count ? 1u : 0u)];
-            float w = by_power ? b->power : (root ? sy_rt_lighttree_importance(b, p, n) : distant_importance(b, n));
+            const sy_rt_lt_bounds *b = root ? &t->nodes[0].b : &t->top_b[i - (t->node_count ? 1u : 0u)];
+            float w = by_power ? b->power : top_importance(t, i, p, n);
             if (w > 0.0f) {
                 *u = 0.99999994f;
                 *chosen = i;
@@ -616,13 +637,13 @@ static void leaf_probs(const sy_rt_lighttree *t, const sy_rt_lt_node *nd, sy_rt_
 uint32_t sy_rt_lighttree_pick(const sy_rt_lighttree *t, sy_rt_v3 p, sy_rt_v3 n, float u, float *pdf)
 {
     *pdf = 0.0f;
-    if (!t->node_count && !t->distant_count) return SY_RT_LT_NONE;
+    if (!t->node_count && !t->top_count) return SY_RT_LT_NONE;
     uint32_t top = 0;
     float prob = top_prob(t, p, n, 0, &u, &top);
     if (!(prob > 0.0f)) return SY_RT_LT_NONE;
     if (!t->node_count || top > 0) {
         *pdf = prob;
-        return t->distant[top - (t->node_count ? 1u : 0u)];
+        return t->top[top - (t->node_count ? 1u : 0u)];
     }
     const sy_rt_lt_node *nd = t->nodes;
     while (!nd->count) {
@@ -644,8 +665,8 @@ uint32_t sy_rt_lighttree_pick(const sy_rt_lighttree *t, sy_rt_v3 p, sy_rt_v3 n, 
 float sy_rt_lighttree_pdf(const sy_rt_lighttree *t, sy_rt_v3 p, sy_rt_v3 n, uint32_t light)
 {
     if (light >= t->light_count) return 0.0f;
-    if (t->light_distant && t->light_distant[light] != SY_RT_LT_NONE)
-        return top_prob(t, p, n, t->light_distant[light] + (t->node_count ? 1u : 0u), NULL, NULL);
+    if (t->light_top && t->light_top[light] != SY_RT_LT_NONE)
+        return top_prob(t, p, n, t->light_top[light] + (t->node_count ? 1u : 0u), NULL, NULL);
     uint32_t k = t->light_prim[light];
     if (k == SY_RT_LT_NONE) return 0.0f;
     /* the path from the root, then the same products in the same order as pick */

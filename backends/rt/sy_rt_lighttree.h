@@ -9,17 +9,19 @@
  * four grandchildren where both its children are inner nodes, else among its two children, and
  * in a leaf (up to SY_RT_LT_LEAF_MAX lights) a light the same way. (Weighing the grandchildren by
  * their own, finer bounds instead of the children's first: relMSE 0.058 -> 0.040 at equal time on
- * `sy bench lights`, the rare picks with huge weights gone; docs/BACKENDS.md "Many lights".) Directional lights have no position: they
- * stand beside the root, each with importance = its irradiance x the bounded surface cosine. The
+ * `sy bench lights`, the rare picks with huge weights gone; docs/BACKENDS.md "Many lights".)
+ * Directional lights have no position: they stand beside the root, each with importance = its
+ * irradiance x the bounded surface cosine; local lights the caller marks `top` stand there too,
+ * each weighed by its own bounds. The
  * probability of the chosen light is the product of the choices; sy_rt_lighttree_pdf recomputes
  * it for any light (each light keeps its leaf, every node its parent), so that a light hit by a
  * BSDF ray gets its MIS weight. Both run the same float operations: pick's pdf equals pdf's.
  *
  * Lights are numbered by the caller (the device: its area triangles, then its punctual lights).
  * Lights with zero, negative or non-finite power, or non-finite bounds, are left out (never
- * picked, pdf 0) and counted in `skipped`. Memory: 72 bytes per light (its record and maps)
- * plus 72 per node (about 0.7 nodes per light; 2 n - 1 are allocated during the build), held in
- * `bytes`: about 120 bytes per light.
+ * picked, pdf 0) and counted in `skipped`; dark ones (below) are left out too, not counted.
+ * Memory: 72 bytes per light (its record and maps) plus 72 per node (about 0.7 nodes per
+ * light; 2 n - 1 are allocated during the build), held in `bytes`: about 120 bytes per light.
  * Not thread-safe to build or update; pick and pdf read only and may run on any number of threads.
  * Internal to backends/rt. */
 #ifndef SY_RT_LIGHTTREE_H
@@ -47,10 +49,17 @@ typedef struct sy_rt_lt_bounds {
 } sy_rt_lt_bounds;
 
 /* One light given to the build. distant: a directional light (only axis = its direction of travel
- * and power = its irradiance are read). */
+ * and power = its irradiance are read); it stands beside the root. top: a local light (a point or
+ * spot light) that stands beside the root too, each pick weighing it by its own bounds instead of
+ * a node's (the caller's choice for a few punctual lights among many emissive triangles: in the
+ * tree, a node they share with triangles bounds both loosely; LightsPunctualLamp, docs/BACKENDS.md).
+ * dark: the caller knows it emits nothing anywhere (a textured emitter's triangle over black
+ * texels): left out like an invalid light, never picked (pdf 0), but not counted in `skipped`. */
 typedef struct sy_rt_lt_light {
     sy_rt_lt_bounds b;
     bool distant;
+    bool top;
+    bool dark;
 } sy_rt_lt_light;
 
 typedef struct sy_rt_lt_node {
@@ -68,11 +77,12 @@ typedef struct sy_rt_lighttree {
     uint32_t *prim_light;   /* leaf order -> light */
     uint32_t *prim_leaf;    /* leaf order -> its leaf node */
     uint32_t prim_count;
-    uint32_t *light_prim;   /* light -> leaf order; SY_RT_LT_NONE: skipped or distant */
-    uint32_t *distant;      /* the directional lights */
-    sy_rt_lt_bounds *distant_b;
-    uint32_t distant_count;
-    uint32_t *light_distant; /* light -> index in distant, SY_RT_LT_NONE otherwise (NULL when none is distant) */
+    uint32_t *light_prim;   /* light -> leaf order; SY_RT_LT_NONE: skipped or at the top */
+    uint32_t *top;          /* the lights beside the root: directional ones and those marked `top` */
+    sy_rt_lt_bounds *top_b;
+    bool *top_local;        /* top entry -> not directional: weighed by sy_rt_lighttree_importance */
+    uint32_t top_count;
+    uint32_t *light_top;    /* light -> index in top, SY_RT_LT_NONE otherwise (NULL when none is at the top) */
     uint32_t skipped;        /* lights left out */
     uint32_t first_skipped;  /* the first of them (SY_RT_LT_NONE when none) */
     size_t bytes;            /* held by the tree */
@@ -84,9 +94,9 @@ typedef struct sy_rt_lighttree {
  * memory (*oom says which). */
 bool sy_rt_lighttree_build(sy_rt_lighttree *t, const sy_rt_lt_light *lights, uint32_t n, size_t max_bytes, bool *oom);
 void sy_rt_lighttree_free(sy_rt_lighttree *t);
-/* Refits *t to lights whose bounds or power changed (same count, same distant flags, none newly
- * skipped or unskipped, at most n / 64 + 1 changed: else false and *t unchanged, the caller
- * rebuilds). Each changed light updates its leaf and the path to the root: O(changed x depth)
+/* Refits *t to lights whose bounds or power changed (same count, same distant, top and dark
+ * flags, none newly skipped or unskipped, at most n / 64 + 1 changed: else false and *t
+ * unchanged, the caller rebuilds). Each changed light updates its leaf and the path to the root: O(changed x depth)
  * plus one pass comparing records. *changed gets how many lights changed. A refitted tree samples
  * differently from a fresh build over the same lights (the same expected image, not the same
  * noise). */

@@ -523,7 +523,7 @@ sy_rt_result sy_rt_pathtracer_render(const sy_rt_frame *f, const sy_rt_render_de
     j.has_env = j.env.mode != 0;
     j.has_punctual = f->dev->punctual_count > 0;
     j.lt = sy_rt_light_tree_get(f->dev, desc->light_tree);
-    if (j.lt && j.lt->node_count + j.lt->distant_count == 0) j.lt = NULL; /* every light left out */
+    if (j.lt && j.lt->node_count + j.lt->top_count == 0) j.lt = NULL; /* every light left out */
     j.categories = j.lt ? 1u + (uint32_t)j.has_env
                         : (uint32_t)j.has_area + (uint32_t)j.has_env + (uint32_t)j.has_punctual;
     atomic_store(&acc->rays, 0u);

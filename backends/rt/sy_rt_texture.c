@@ -62,6 +62,7 @@ sy_rt_result sy_rt_texture_destroy(sy_rt_device *dev, sy_rt_texture tex)
 void sy_rt_texture_free(sy_rt_texture_data *tex)
 {
     if (!tex) return;
+    free(tex->zero_sat);
     free(tex->pixels);
     free(tex);
 }
@@ -167,6 +168,93 @@ void sy_rt_texture_ref_uv(const sy_rt_texture_ref *ref, const float uv[2][2], fl
     const float *m = ref->transform;
     out[0] = m[0] * c[0] + m[1] * c[1] + m[2];
     out[1] = m[3] * c[0] + m[4] * c[1] + m[5];
+}
+
+/* >>regions that read only zero texels (the light tree leaves such emitter triangles out) */
+
+/* Whether texel (x, y) has a non-zero colour channel (NaN counts as non-zero). */
+static bool texel_nonzero(const sy_rt_texture_data *t, uint32_t x, uint32_t y)
+{
+    size_t base = ((size_t)y * t->width + x) * t->channels;
+    uint32_t n = t->channels >= 3u ? 3u : 1u; /* grey(-alpha) textures: the grey channel */
+    for (uint32_t k = 0; k < n; ++k) {
+        if (t->format == SY_RT_TEXEL_FLOAT32) {
+            if (!(((const float *)t->pixels)[base + k] == 0.0f)) return true;
+        } else if (((const uint8_t *)t->pixels)[base + k] != 0u) { /* 0 decodes to 0 (sRGB too), any other code above */
+            return true;
+        }
+    }
+    return false;
+}
+
+static bool zero_table(sy_rt_texture_data *t)
+{
+    if (t->zero_sat) return true;
+    if (t->zero_failed) return false;
+    uint32_t s = 3u; /* 8 x 8 blocks, larger for textures past 4096 texels a side */
+    while (((t->width - 1u) >> s) + 1u > 512u || ((t->height - 1u) >> s) + 1u > 512u) ++s;
+    uint32_t bw = ((t->width - 1u) >> s) + 1u, bh = ((t->height - 1u) >> s) + 1u, stride = bw + 1u;
+    uint32_t *sat = calloc((size_t)stride * (bh + 1u), sizeof *sat);
+    if (!sat) {
+        t->zero_failed = true;
+        return false;
+    }
+    for (uint32_t y = 0; y < t->height; ++y) {
+        uint32_t *row = sat + (size_t)((y >> s) + 1u) * stride + 1u;
+        for (uint32_t x = 0; x < t->width; ++x)
+            if (!row[x >> s] && texel_nonzero(t, x, y)) row[x >> s] = 1u;
+    }
+    for (uint32_t by = 1; by <= bh; ++by) /* prefix sums: sat[by][bx] = lit blocks above and left of (bx, by) */
+        for (uint32_t bx = 1; bx <= bw; ++bx)
+            sat[(size_t)by * stride + bx] += sat[(size_t)(by - 1u) * stride + bx] + sat[(size_t)by * stride + bx - 1u] -
+                                             sat[(size_t)(by - 1u) * stride + bx - 1u];
+    t->zero_sat = sat, t->zero_shift = s, t->zero_bw = bw, t->zero_bh = bh;
+    return true;
+}
+
+/* The texel indices along one axis that lookups at texel coordinates in [lo, hi] can read (the
+ * bilinear taps around them; nearest's texel is among them), as up to two ranges of [0, n):
+ * the span is cut where the wrap mode's map turns (multiples of n), monotonic in each piece. */
+static int axis_ranges(double lo, double hi, uint32_t n, sy_rt_wrap mode, uint32_t out[2][2])
+{
+    int64_t a = (int64_t)floor(lo - 0.5), b = (int64_t)floor(hi - 0.5) + 1;
+    int64_t nn = (int64_t)n;
+    if (b - a + 1 >= nn) {
+        out[0][0] = 0, out[0][1] = n - 1u;
+        return 1;
+    }
+    int64_t q = a >= 0 ? a / nn : -((-a + nn - 1) / nn); /* floor(a / n) */
+    int64_t cut = (q + 1) * nn;
+    int64_t piece[2][2] = {{a, b < cut - 1 ? b : cut - 1}, {cut, b}};
+    int k = b >= cut ? 2 : 1;
+    for (int i = 0; i < k; ++i) {
+        uint32_t u = wrap_index(piece[i][0], n, mode), v = wrap_index(piece[i][1], n, mode);
+        out[i][0] = u < v ? u : v, out[i][1] = u < v ? v : u;
+    }
+    return k;
+}
+
+bool sy_rt_texture_region_zero(sy_rt_texture_data *t, const float uv[3][2])
+{
+    float lo[2] = {uv[0][0], uv[0][1]}, hi[2] = {uv[0][0], uv[0][1]};
+    for (int c = 0; c < 3; ++c)
+        for (int k = 0; k < 2; ++k) {
+            if (!isfinite(uv[c][k]) || fabsf(uv[c][k]) > 1e6f) return false;
+            lo[k] = fminf(lo[k], uv[c][k]), hi[k] = fmaxf(hi[k], uv[c][k]);
+        }
+    if (!zero_table(t)) return false;
+    /* a thousandth of a texel more each side: interpolated coordinates round past the corners' */
+    uint32_t rx[2][2], ry[2][2];
+    int nx = axis_ranges((double)lo[0] * t->width - 1e-3, (double)hi[0] * t->width + 1e-3, t->width, t->wrap_s, rx);
+    int ny = axis_ranges((double)lo[1] * t->height - 1e-3, (double)hi[1] * t->height + 1e-3, t->height, t->wrap_t, ry);
+    const uint32_t *sat = t->zero_sat, s = t->zero_shift, stride = t->zero_bw + 1u;
+    for (int i = 0; i < nx; ++i)
+        for (int j = 0; j < ny; ++j) {
+            size_t x0 = rx[i][0] >> s, x1 = (rx[i][1] >> s) + 1u, y0 = ry[j][0] >> s, y1 = (ry[j][1] >> s) + 1u;
+            uint32_t lit = sat[y1 * stride + x1] - sat[y0 * stride + x1] - sat[y1 * stride + x0] + sat[y0 * stride + x0];
+            if (lit) return false;
+        }
+    return true;
 }
 
 bool sy_rt_texture_sample_set_ref(const sy_rt_device *dev, const sy_rt_texture_ref *ref, const float uv[2][2],

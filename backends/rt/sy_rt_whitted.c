@@ -1197,7 +1197,7 @@ sy_rt_result sy_rt_whitted_render(const sy_rt_frame *f, const sy_rt_render_desc 
     j->spp_max = j->spp > 1u && j->spp < REFINE_MAX_SPP ? (j->spp * REFINE_FACTOR < REFINE_MAX_SPP ? j->spp * REFINE_FACTOR : REFINE_MAX_SPP) : j->spp;
     j->n_env = j->env.mode ? (desc->env_light_samples ? desc->env_light_samples : 4u) : 0u;
     j->lt = sy_rt_light_tree_get(dev, desc->light_tree);
-    if (j->lt && j->lt->node_count + j->lt->distant_count == 0) j->lt = NULL; /* every light left out */
+    if (j->lt && j->lt->node_count + j->lt->top_count == 0) j->lt = NULL; /* every light left out */
     j->area_analytic = !j->lt && dev->area_count > 0 && dev->area_count <= ANALYTIC_MAX_TRIANGLES;
     /* textured emitters, and emitters that move over the shutter (the closed form integrates the
      * open's polygons; the sampled estimator places each at its ray's time: sy_rt_area_at), take the

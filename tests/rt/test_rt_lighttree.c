@@ -67,18 +67,20 @@ static void test_pdf_sums(void)
     l[21].b.power = -1.0f;
     l[22].b.power = NAN;
     l[23].b.lo[0] = NAN;
+    l[24].dark = true; /* valid records the caller knows emit nothing (black texels): out, not counted */
+    l[25].dark = true, l[25].b.power = 0.0f;
     sy_rt_lighttree t;
     bool oom;
     EXPECT_MSG(sy_rt_lighttree_build(&t, l, n, 0, &oom), "build of %u lights", n);
     EXPECT_MSG(t.skipped == 4u && t.first_skipped == 20u, "skipped %u (4), first %u (20)", t.skipped, t.first_skipped);
-    EXPECT_MSG(t.distant_count == 2u, "directional lights %u (2)", t.distant_count);
+    EXPECT_MSG(t.top_count == 2u, "directional lights %u (2)", t.top_count);
     double worst = 0.0;
     for (int k = 0; k < 64; ++k) {
         sy_rt_v3 p = random_point(), nrm = k % 2 ? v3_normalize(v3(frand() - 0.5f, 1.0f, frand() - 0.5f)) : v3(0, 0, 0);
         double s = 0.0;
         for (uint32_t i = 0; i < n; ++i) s += sy_rt_lighttree_pdf(&t, p, nrm, i);
         worst = fmax(worst, fabs(s - 1.0));
-        for (uint32_t i = 20; i < 24; ++i) EXPECT_MSG(sy_rt_lighttree_pdf(&t, p, nrm, i) == 0.0f, "left-out light %u has pdf 0", i);
+        for (uint32_t i = 20; i < 26; ++i) EXPECT_MSG(sy_rt_lighttree_pdf(&t, p, nrm, i) == 0.0f, "left-out light %u has pdf 0", i);
     }
     EXPECT_MSG(worst < 1e-3, "the pdfs over all lights sum to 1 at every point (worst |sum - 1| %.2e)", worst);
     /* refit: one light's power */
@@ -92,6 +94,20 @@ static void test_pdf_sums(void)
     /* a light that becomes degenerate needs a rebuild */
     l[101].b.power = 0.0f;
     EXPECT_MSG(!sy_rt_lighttree_refit(&t, l, n, &changed), "refit refuses a light that left the set");
+    l[101].b.power = 1.0f, l[101].dark = true;
+    EXPECT_MSG(!sy_rt_lighttree_refit(&t, l, n, &changed), "refit refuses a light that turned dark");
+    l[101].dark = false, l[24].dark = false;
+    EXPECT_MSG(!sy_rt_lighttree_refit(&t, l, n, &changed), "refit refuses a dark light that turned lit");
+    l[24].dark = true;
+    l[32].top = true;
+    EXPECT_MSG(!sy_rt_lighttree_refit(&t, l, n, &changed), "refit refuses a light moved beside the root");
+    l[32].top = false;
+    EXPECT_MSG(sy_rt_lighttree_refit(&t, l, n, &changed), "refit takes the same dark lights");
+    for (int k = 0; k < 2000; ++k) {
+        float pdf;
+        uint32_t pick = sy_rt_lighttree_pick(&t, random_point(), v3(0, 0, 0), frand(), &pdf);
+        EXPECT_MSG(pick != 24u && pick != 25u, "a dark light is never picked (%u)", pick);
+    }
     sy_rt_lighttree_free(&t);
     free(l);
 }
@@ -145,9 +161,12 @@ static void test_counting(void)
     sy_rt_lt_light l[60];
     for (uint32_t i = 0; i < n; ++i) random_light(&l[i], i);
     l[3].distant = true;
+    l[7].top = true, l[12].top = true; /* two point lights beside the root */
     sy_rt_lighttree t;
     bool oom;
     EXPECT_MSG(sy_rt_lighttree_build(&t, l, n, 0, &oom), "build of 60 lights");
+    EXPECT_MSG(t.top_count == 3u && t.top_local[t.light_top[7]] && !t.top_local[t.light_top[3]],
+               "beside the root: the directional light and the two marked point lights (%u)", t.top_count);
     uint32_t *count = calloc(n, sizeof *count);
     uint32_t mismatches = 0;
     double worst = 0.0;
@@ -166,6 +185,18 @@ static void test_counting(void)
         }
         for (uint32_t i = 0; i < n; ++i)
             worst = fmax(worst, fabs((double)count[i] / picks - sy_rt_lighttree_pdf(&t, p, nrm, i)));
+        /* a top point light against the root: their importances' ratio, each by its own bounds */
+        float i7 = sy_rt_lighttree_importance(&t.top_b[t.light_top[7]], p, nrm);
+        float ir = sy_rt_lighttree_importance(&t.nodes[0].b, p, nrm);
+        double want = (double)i7 / ir;
+        if (ir > 0.0f && i7 > 0.0f) {
+            double root_share = 0.0; /* the root's probability: the sum over the tree's lights */
+            for (uint32_t i = 0; i < n; ++i)
+                if (i != 3u && i != 7u && i != 12u) root_share += sy_rt_lighttree_pdf(&t, p, nrm, i);
+            double ratio = sy_rt_lighttree_pdf(&t, p, nrm, 7) / root_share;
+            EXPECT_MSG(fabs(ratio / want - 1.0) < 1e-3, "top point light to root: %.6f (its importance over the root's %.6f)",
+                       ratio, want);
+        }
     }
     EXPECT_MSG(mismatches == 0u, "every pick returns a light whose pdf equals sy_rt_lighttree_pdf (%u mismatches)", mismatches);
     EXPECT_MSG(worst < 0.002, "pick frequencies match the pdfs (worst difference %.5f)", worst);

@@ -1,6 +1,8 @@
 /* test_rt_texture.c — the ray tracers' texture look-up (backends/rt/sy_rt_texture.h): bilinear
  * taps across the edges of a texture for each wrap mode (repeat, clamp, mirror) and far outside
- * [0, 1], against the same filter written here with an independent wrap; nearest look-ups. */
+ * [0, 1], against the same filter written here with an independent wrap; nearest look-ups; the
+ * test whether a triangle of texture coordinates reads only zero texels (sy_rt_texture_region_zero,
+ * the light tree's dark emitter triangles) against look-ups inside random triangles. */
 #include "rt_test.h"
 #include "sy_rt_texture.h"
 
@@ -18,8 +20,81 @@ static uint32_t ref_wrap(long long i, uint32_t n, sy_rt_wrap mode)
     return (uint32_t)(m < (long long)n ? m : p - 1 - m);
 }
 
+static uint32_t lcg(uint32_t *s)
+{
+    *s = *s * 1664525u + 1013904223u;
+    return *s >> 8;
+}
+static float rnd(uint32_t *s) { return (float)lcg(s) / 16777216.0f; }
+
+/* Whether any look-up of t inside triangle uv reads a non-zero colour: its corners, edge points
+ * and random interior points, with the filter t has. */
+static bool region_reads_nonzero(const sy_rt_texture_data *t, const float uv[3][2], uint32_t *seed)
+{
+    for (int i = 0; i < 400; ++i) {
+        float b1, b2;
+        if (i < 3) {
+            b1 = i == 1, b2 = i == 2;
+        } else if (i < 60) { /* along the edges */
+            float f = rnd(seed);
+            int e = i % 3;
+            b1 = e == 0 ? f : (e == 1 ? 1.0f - f : 0.0f), b2 = e == 0 ? 0.0f : (e == 1 ? f : 1.0f - f);
+        } else {
+            b1 = rnd(seed), b2 = rnd(seed);
+            if (b1 + b2 > 1.0f) b1 = 1.0f - b1, b2 = 1.0f - b2;
+        }
+        float b0 = 1.0f - b1 - b2, out[4];
+        float u = b0 * uv[0][0] + b1 * uv[1][0] + b2 * uv[2][0], v = b0 * uv[0][1] + b1 * uv[1][1] + b2 * uv[2][1];
+        sy_rt_texture_sample(t, u, v, out);
+        if (out[0] != 0.0f || out[1] != 0.0f || out[2] != 0.0f) return true;
+    }
+    return false;
+}
+
+/* Region tests on an RGBA8 texture of w x h texels, black but for `lit` random texels (one with
+ * only alpha set, which must not count), every wrap mode and filter: a triangle any look-up of
+ * which reads a non-zero colour is never called zero; some are (the table is not "never zero"). */
+static void test_region_zero(uint32_t w, uint32_t h, uint32_t lit, uint32_t seed)
+{
+    uint8_t *px = calloc((size_t)w * h * 4u, 1);
+    if (!px) return;
+    for (uint32_t i = 0; i < lit; ++i) {
+        size_t y = lcg(&seed) % h, x = lcg(&seed) % w;
+        px[(y * w + x) * 4u + lcg(&seed) % 3u] = (uint8_t)(1u + lcg(&seed) % 255u);
+    }
+    px[((size_t)(h / 2u) * w + w / 2u) * 4u + 3u] = 255u; /* alpha only */
+    static const sy_rt_wrap modes[3] = {SY_RT_WRAP_REPEAT, SY_RT_WRAP_CLAMP, SY_RT_WRAP_MIRROR};
+    for (int mi = 0; mi < 3; ++mi)
+        for (int f = 0; f < 2; ++f) {
+            sy_rt_texture_data t = {.width = w, .height = h, .channels = 4, .format = SY_RT_TEXEL_UNORM8, .pixels = px,
+                                    .wrap_s = modes[mi], .wrap_t = modes[(mi + 1) % 3],
+                                    .filter = f ? SY_RT_FILTER_NEAREST : SY_RT_FILTER_LINEAR};
+            uint32_t zero = 0, wrong = 0, tris = 3000;
+            for (uint32_t k = 0; k < tris; ++k) {
+                float uv[3][2], size = k % 3u == 0 ? 0.3f : (k % 3u == 1 ? 0.02f : 0.002f);
+                float cu = rnd(&seed) * 4.0f - 2.0f, cv = rnd(&seed) * 4.0f - 2.0f;
+                for (int c = 0; c < 3; ++c) uv[c][0] = cu + size * rnd(&seed), uv[c][1] = cv + size * rnd(&seed);
+                bool z = sy_rt_texture_region_zero(&t, (const float(*)[2])uv);
+                zero += z;
+                if (z && region_reads_nonzero(&t, (const float(*)[2])uv, &seed) && wrong++ == 0)
+                    EXPECT_MSG(false, "%ux%u, wrap %d/%d, %s: triangle (%g,%g) (%g,%g) (%g,%g) called zero, reads a non-zero texel",
+                               w, h, (int)t.wrap_s, (int)t.wrap_t, f ? "nearest" : "bilinear", uv[0][0], uv[0][1], uv[1][0],
+                               uv[1][1], uv[2][0], uv[2][1]);
+            }
+            EXPECT_MSG(wrong == 0, "%ux%u: %u triangles wrongly called zero", w, h, wrong);
+            EXPECT_MSG(zero > tris / 10u, "%ux%u, wrap %d/%d: only %u of %u triangles called zero (mostly black texture)", w, h,
+                       (int)t.wrap_s, (int)t.wrap_t, zero, tris);
+            float nan_uv[3][2] = {{NAN, 0.0f}, {0.0f, 0.0f}, {0.0f, 0.0f}};
+            EXPECT_MSG(!sy_rt_texture_region_zero(&t, (const float(*)[2])nan_uv), "a non-finite coordinate is never zero");
+            free(t.zero_sat);
+        }
+    free(px);
+}
+
 int main(void)
 {
+    test_region_zero(37, 29, 6, 1u);      /* blocks of 8 texels, a partial block at each edge */
+    test_region_zero(4500, 40, 300, 2u);  /* wider than 512 blocks of 8: blocks of 16 */
     float px[W] = {0.0f, 10.0f, 20.0f, 30.0f, 40.0f}; /* one row, one channel */
     static const sy_rt_wrap modes[3] = {SY_RT_WRAP_REPEAT, SY_RT_WRAP_CLAMP, SY_RT_WRAP_MIRROR};
     static const char *const names[3] = {"repeat", "clamp", "mirror"};
