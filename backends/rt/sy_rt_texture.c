@@ -54,8 +54,11 @@ sy_rt_result sy_rt_texture_destroy(sy_rt_device *dev, sy_rt_texture tex)
     sy_rt_texture_data *t = sy_rt_pool_take(dev, &dev->textures, tex.id, "texture destroy");
     if (!t) return SY_RT_ERROR_INVALID_HANDLE;
     sy_rt_texture_free(t);
-    /* Emissive textures shape the area lights only at sample time, so no rebuild is needed. */
+    /* Emissive textures shape the area lights at sample time, and the light tree, which leaves
+     * out triangles over black texels: its next use builds it again (a material still naming the
+     * texture reads its plain emissive factor). */
     dev->dirty = true;
+    dev->light_tree_dirty = true;
     return SY_RT_OK;
 }
 

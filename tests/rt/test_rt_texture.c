@@ -51,9 +51,9 @@ static bool region_reads_nonzero(const sy_rt_texture_data *t, const float uv[3][
     return false;
 }
 
-/* Region tests on an RGBA8 texture of w x h texels, black but for `lit` random texels (one with
- * only alpha set, which must not count), every wrap mode and filter: a triangle any look-up of
- * which reads a non-zero colour is never called zero; some are (the table is not "never zero"). */
+/* Region tests on an RGBA8 texture of w x h texels, black but for `lit` random texels (and one
+ * with only alpha set), every wrap mode and filter: a triangle any look-up of which reads a
+ * non-zero colour is never called zero; some are (the table is not "never zero"). */
 static void test_region_zero(uint32_t w, uint32_t h, uint32_t lit, uint32_t seed)
 {
     uint8_t *px = calloc((size_t)w * h * 4u, 1);
