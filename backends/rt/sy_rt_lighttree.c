@@ -529,12 +529,20 @@ static uint32_t choose(const float *p, uint32_t k, float *u)
     return last;
 }
 
-/* The importance of top entry i (0: the root when there is a tree) at (p, n). */
+/* The bounds of top entry i (0: the root when there is a tree). */
+static const sy_rt_lt_bounds *top_bounds(const sy_rt_lighttree *t, uint32_t i)
+{
+    return t->node_count && i == 0 ? &t->nodes[0].b : &t->top_b[i - (t->node_count ? 1u : 0u)];
+}
+
+/* The importance of top entry i at (p, n): the root and local lights by their bounds, directional
+ * lights by their irradiance. */
 static float top_importance(const sy_rt_lighttree *t, uint32_t i, sy_rt_v3 p, sy_rt_v3 n)
 {
-    if (t->node_count && i == 0) return sy_rt_lighttree_importance(&t->nodes[0].b, p, n);
-    uint32_t k = i - (t->node_count ? 1u : 0u);
-    return t->top_local[k] ? sy_rt_lighttree_importance(&t->top_b[k], p, n) : distant_importance(&t->top_b[k], n);
+    bool root = t->node_count && i == 0;
+    const sy_rt_lt_bounds *b = top_bounds(t, i);
+    return root || t->top_local[i - (t->node_count ? 1u : 0u)] ? sy_rt_lighttree_importance(b, p, n)
+                                                                : distant_importance(b, n);
 }
 
 /* The top level: the root (when there is a tree), then the lights beside it (directional ones and
@@ -547,17 +555,13 @@ static float top_prob(const sy_rt_lighttree *t, sy_rt_v3 p, sy_rt_v3 n, uint32_t
     float s = 0.0f, ps = 0.0f;
     uint32_t k = (t->node_count ? 1u : 0u) + t->top_count;
     for (uint32_t i = 0; i < k; ++i) {
-        bool root = t->node_count && i == 0;
-        const sy_rt_lt_bounds *b = root ? &t->nodes[0].b : &t->top_b[i - (t->node_count ? 1u : 0u)];
         s += top_importance(t, i, p, n);
-        ps += b->power;
+        ps += top_bounds(t, i)->power;
     }
     bool by_power = !(s > 0.0f) || !isfinite(s);
     float total = by_power ? ps : s, acc = 0.0f;
     for (uint32_t i = 0; i < k; ++i) {
-        bool root = t->node_count && i == 0;
-        const sy_rt_lt_bounds *b = root ? &t->nodes[0].b : &t->top_b[i - (t->node_count ? 1u : 0u)];
-        float w = by_power ? b->power : top_importance(t, i, p, n);
+        float w = by_power ? top_bounds(t, i)->power : top_importance(t, i, p, n);
         float pr = w / total;
         if (u) {
             if (pr > 0.0f && (*u < acc + pr || i + 1u == k)) {
@@ -572,9 +576,7 @@ static float top_prob(const sy_rt_lighttree *t, sy_rt_v3 p, sy_rt_v3 n, uint32_t
     }
     if (u) { /* rounding left u past the last nonzero entry */
         for (uint32_t i = k; i-- > 0;) {
-            bool root = t->node_count && i == 0;
-            const sy_rt_lt_bounds *b = root ? &t->nodes[0].b : &t->top_b[i - (t->node_count ? 1u : 0u)];
-            float w = by_power ? b->power : top_importance(t, i, p, n);
+            float w = by_power ? top_bounds(t, i)->power : top_importance(t, i, p, n);
             if (w > 0.0f) {
                 *u = 0.99999994f;
                 *chosen = i;
