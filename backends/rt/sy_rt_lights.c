@@ -227,6 +227,8 @@ sy_rt_result sy_rt_env_rebuild(sy_rt_device *dev)
     return SY_RT_OK;
 }
 
+static sy_rt_v3 latlong_eval(const sy_rt_texture_data *tex, float intensity, sy_rt_v3 d);
+
 void sy_rt_env_get(const sy_rt_device *dev, sy_rt_env *env)
 {
     memset(env, 0, sizeof *env);
@@ -237,6 +239,13 @@ void sy_rt_env_get(const sy_rt_device *dev, sy_rt_env *env)
         env->intensity = dev->env_intensity;
         env->dist = dev->env_dist;
         env->filter = dev->env_filter;
+        if (t->width == 1u && t->height == 1u) {
+            /* A 1x1 texture reads its one texel whatever the direction: the four bilinear taps are
+             * the same texel, so a + (b - a) fx is a exactly (and NaN for a non-finite texel, as
+             * any lookup gives); one lookup here spares every ray its atan2 and acos. */
+            env->constant = true;
+            env->constant_radiance = latlong_eval(t, env->intensity, v3(0.0f, 0.0f, -1.0f));
+        }
     }
 }
 
@@ -261,6 +270,7 @@ static sy_rt_v3 latlong_eval(const sy_rt_texture_data *tex, float intensity, sy_
 sy_rt_v3 sy_rt_env_eval(const sy_rt_env *env, sy_rt_v3 d)
 {
     if (env->mode != 2) return v3(0.0f, 0.0f, 0.0f);
+    if (env->constant) return env->constant_radiance;
     return latlong_eval(env->tex, env->intensity, d);
 }
 
@@ -284,11 +294,15 @@ float sy_rt_env_pdf(const sy_rt_env *env, sy_rt_v3 d)
 {
     if (env->mode != 2) return 0.0f;
     const sy_rt_env_dist *e = env->dist;
-    float u, v;
-    dir_to_uv(d, &u, &v);
-    uint32_t x = (uint32_t)(u * (float)e->width), y = (uint32_t)(v * (float)e->height);
-    if (x >= e->width) x = e->width - 1u;
-    if (y >= e->height) y = e->height - 1u;
+    uint32_t x = 0u, y = 0u; /* a 1x1 distribution has one texel: no need for the direction's u, v */
+    if (e->width > 1u || e->height > 1u) {
+        float u, v;
+        dir_to_uv(d, &u, &v);
+        x = (uint32_t)(u * (float)e->width);
+        y = (uint32_t)(v * (float)e->height);
+        if (x >= e->width) x = e->width - 1u;
+        if (y >= e->height) y = e->height - 1u;
+    }
     float st = sqrtf(fmaxf(0.0f, 1.0f - d.y * d.y)); /* sin(theta) of d itself: the density in u, v is uniform */
     if (!(st > 0.0f)) return 0.0f;
     /* texel solid angle = (2 pi / w) (pi / h) sin(theta) */

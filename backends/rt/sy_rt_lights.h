@@ -35,6 +35,8 @@ typedef struct sy_rt_env {
     float intensity;
     const sy_rt_env_dist *dist;     /* mode 2 */
     const struct sy_rt_envfilter *filter; /* mode 2: Whitted's prefiltered maps, once built (else NULL) */
+    bool constant;                  /* mode 2 with a 1x1 texture (--env-color): every direction reads */
+    sy_rt_v3 constant_radiance;     /* this radiance, the same value the lookup returns bit for bit */
 } sy_rt_env;
 
 /* Resolves the committed environment of dev (texture lookups happen once per frame). */

@@ -2,11 +2,16 @@
  * taps across the edges of a texture for each wrap mode (repeat, clamp, mirror) and far outside
  * [0, 1], against the same filter written here with an independent wrap; nearest look-ups; the
  * test whether a triangle of texture coordinates reads only zero texels (sy_rt_texture_region_zero,
- * the light tree's dark emitter triangles) against look-ups inside random triangles. */
+ * the light tree's dark emitter triangles) against look-ups inside random triangles; the
+ * environment light of a 1x1 texture (--env-color; read once, not per direction) against the same
+ * texel in a 2x1 texture, which goes through the lat-long look-up: the same radiance and pdf bit for
+ * bit in every direction, non-finite and negative texels read as 0 alike. */
 #include "rt_test.h"
+#include "sy_rt_lights.h"
 #include "sy_rt_texture.h"
 
 #define W 5u
+#define PI_F 3.14159265358979f
 
 /* The texel a wrap mode reads for integer texel coordinate i (written out, not shared with the
  * back-end): repeat, clamp, mirror (0 1 .. n-1 n-1 .. 1 0 0 1 ..). */
@@ -91,8 +96,61 @@ static void test_region_zero(uint32_t w, uint32_t h, uint32_t lit, uint32_t seed
     free(px);
 }
 
+/* A device whose environment light is a w x 1 float texture of one colour, at intensity k. */
+static sy_rt_device *env_device(uint32_t w, const float c[3], float k, sy_rt_env *env)
+{
+    sy_rt_device *dev = rt_device();
+    float px[2 * 3];
+    for (uint32_t i = 0; i < w; ++i) px[3 * i] = c[0], px[3 * i + 1] = c[1], px[3 * i + 2] = c[2];
+    sy_rt_texture_desc td = {.width = w, .height = 1, .channels = 3, .format = SY_RT_TEXEL_FLOAT32, .pixels = px};
+    sy_rt_texture tex;
+    MUST(sy_rt_texture_create(dev, &td, &tex));
+    MUST(sy_rt_set_environment(dev, tex, k));
+    MUST(sy_rt_commit(dev));
+    sy_rt_env_get(dev, env);
+    return dev;
+}
+
+static void test_env_constant(void)
+{
+    const float colours[][3] = {{0.25f, 0.5f, 1.0f}, {1.0f / 3.0f, 0.1f, 7.77f}, {2.0f, -1.0f, 0.3f},
+                                {INFINITY, 1.0f, 0.5f}, {NAN, 0.0f, 1.0f}};
+    for (size_t ci = 0; ci < sizeof colours / sizeof colours[0]; ++ci) {
+        const float *c = colours[ci];
+        bool finite = isfinite(c[0]) && isfinite(c[1]) && isfinite(c[2]);
+        sy_rt_env one, two;
+        sy_rt_device *d1 = env_device(1u, c, 1.7f, &one), *d2 = env_device(2u, c, 1.7f, &two);
+        EXPECT_MSG(one.mode == 2 && two.mode == 2, "colour %zu: environment light present", ci);
+        uint32_t seed = 99u + (uint32_t)ci;
+        int bad_eval = 0, bad_pdf = 0;
+        for (int i = 0; i < 4000; ++i) {
+            sy_rt_v3 d;
+            if (i < 6) { /* the poles and the seam of atan2 */
+                const float ax[6][3] = {{0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {1, 0, 0}, {-1, 0, 0}};
+                d = v3(ax[i][0], ax[i][1], ax[i][2]);
+            } else {
+                float z = 2.0f * rnd(&seed) - 1.0f, ph = 2.0f * PI_F * rnd(&seed), r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+                d = v3(r * cosf(ph), z, r * sinf(ph));
+            }
+            sy_rt_v3 a = sy_rt_env_eval(&one, d), b = sy_rt_env_eval(&two, d);
+            if (memcmp(&a, &b, sizeof a) != 0) ++bad_eval;
+            if (finite && sy_rt_env_pdf(&one, d) != sy_rt_env_pdf(&two, d)) ++bad_pdf;
+        }
+        sy_rt_v3 a = sy_rt_env_eval(&one, v3(0.0f, 0.0f, -1.0f));
+        float want[3];
+        for (int k = 0; k < 3; ++k) want[k] = isfinite(c[0]) && isfinite(c[1]) && isfinite(c[2]) ? fmaxf(c[k] * 1.7f, 0.0f) : 0.0f;
+        EXPECT_MSG(a.x == want[0] && a.y == want[1] && a.z == want[2], "colour %zu: radiance %g %g %g, want %g %g %g", ci,
+                   a.x, a.y, a.z, want[0], want[1], want[2]);
+        EXPECT_MSG(bad_eval == 0, "colour %zu: 1x1 and 2x1 environments differ in %d of 4000 directions", ci, bad_eval);
+        EXPECT_MSG(bad_pdf == 0, "colour %zu: 1x1 and 2x1 pdfs differ in %d of 4000 directions", ci, bad_pdf);
+        sy_rt_device_destroy(d1);
+        sy_rt_device_destroy(d2);
+    }
+}
+
 int main(void)
 {
+    test_env_constant();
     test_region_zero(37, 29, 6, 1u);      /* blocks of 8 texels, a partial block at each edge */
     test_region_zero(4500, 40, 300, 2u);  /* wider than 512 blocks of 8: blocks of 16 */
     float px[W] = {0.0f, 10.0f, 20.0f, 30.0f, 40.0f}; /* one row, one channel */
