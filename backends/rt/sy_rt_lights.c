@@ -213,6 +213,14 @@ sy_rt_result sy_rt_env_rebuild(sy_rt_device *dev)
         rows[y] = acc;
         total += acc;
     }
+    double lum_sphere = 0.0, w_sphere = 0.0; /* the mean luminance, each row by its sin(theta) */
+    for (uint32_t y = 0; y < h; ++y) {
+        double s = sin(PI_F * ((double)y + 0.5) / (double)h), row = 0.0;
+        for (uint32_t x = 0; x < w; ++x) row += lum[(size_t)y * w + x];
+        lum_sphere += row * s;
+        w_sphere += (double)w * s;
+    }
+    d->mean_luminance = w_sphere > 0.0 ? (float)(lum_sphere / w_sphere) : 0.0f;
     double acc = 0.0;
     d->marginal[0] = 0.0f;
     for (uint32_t y = 0; y < h; ++y) {
@@ -239,6 +247,7 @@ void sy_rt_env_get(const sy_rt_device *dev, sy_rt_env *env)
         env->intensity = dev->env_intensity;
         env->dist = dev->env_dist;
         env->filter = dev->env_filter;
+        env->irradiance = PI_F * dev->env_dist->mean_luminance * dev->env_intensity;
         if (t->width == 1u && t->height == 1u) {
             /* A 1x1 texture reads its one texel whatever the direction: the four bilinear taps are
              * the same texel, so a + (b - a) fx is a exactly (and NaN for a non-finite texel, as

@@ -15,6 +15,7 @@ typedef struct sy_rt_env_dist {
     float *marginal;    /* height + 1 entries: CDF over rows */
     float *conditional; /* height x (width + 1): CDF over the texels of each row */
     float *texel_pdf;   /* width x height: probability of each texel (sums to 1) */
+    float mean_luminance; /* the texture's luminance averaged over the sphere (solid-angle weights) */
 } sy_rt_env_dist;
 
 /* (Re)builds dev->area_alias_* from per-triangle weights (n entries, total > 0). Returns false when
@@ -35,6 +36,8 @@ typedef struct sy_rt_env {
     float intensity;
     const sy_rt_env_dist *dist;     /* mode 2 */
     const struct sy_rt_envfilter *filter; /* mode 2: Whitted's prefiltered maps, once built (else NULL) */
+    float irradiance;               /* mode 2: pi x mean luminance x intensity, what a surface facing
+                                     * the unoccluded environment receives (the light tree's split) */
     bool constant;                  /* mode 2 with a 1x1 texture (--env-color): every direction reads */
     sy_rt_v3 constant_radiance;     /* this radiance, the same value the lookup returns bit for bit */
 } sy_rt_env;

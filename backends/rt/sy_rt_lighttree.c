@@ -545,6 +545,14 @@ static float top_importance(const sy_rt_lighttree *t, uint32_t i, sy_rt_v3 p, sy
                                                                 : distant_importance(b, n);
 }
 
+float sy_rt_lighttree_total_importance(const sy_rt_lighttree *t, sy_rt_v3 p, sy_rt_v3 n)
+{
+    float s = 0.0f;
+    uint32_t k = (t->node_count ? 1u : 0u) + t->top_count;
+    for (uint32_t i = 0; i < k; ++i) s += top_importance(t, i, p, n);
+    return s;
+}
+
 /* The top level: the root (when there is a tree), then the lights beside it (directional ones and
  * local ones marked top), each in proportion to its importance (by power where none has any).
  * With u: chooses one (*chosen, u rescaled) and returns its probability; else returns entry

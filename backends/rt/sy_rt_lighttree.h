@@ -108,6 +108,10 @@ bool sy_rt_lighttree_refit(sy_rt_lighttree *t, const sy_rt_lt_light *lights, uin
 uint32_t sy_rt_lighttree_pick(const sy_rt_lighttree *t, sy_rt_v3 p, sy_rt_v3 n, float u, float *pdf);
 /* The probability with which sy_rt_lighttree_pick(t, p, n, .) returns light (0 for a skipped one). */
 float sy_rt_lighttree_pdf(const sy_rt_lighttree *t, sy_rt_v3 p, sy_rt_v3 n, uint32_t light);
+/* The sum of the importances at (p, n) of the top level's entries (the root and the lights beside
+ * it), by which pick chooses among them: how much light the whole tree can bring to p, in the units
+ * of irradiance (a light of power P on axis at distance d gives P / d^2). 0 for an empty tree. */
+float sy_rt_lighttree_total_importance(const sy_rt_lighttree *t, sy_rt_v3 p, sy_rt_v3 n);
 /* Importance of bounds b at (p, n), the measure both use (exposed for tests). */
 float sy_rt_lighttree_importance(const sy_rt_lt_bounds *b, sy_rt_v3 p, sy_rt_v3 n);
 /* sy_rt_lighttree_importance of four bounds at once, into out[0..3], each bit for bit the scalar

@@ -8,7 +8,8 @@
  * area / environment / punctual, an emissive triangle by power through the alias table, a uniform
  * point on it; with the light tree, render desc light_tree and sy_rt_lighttree.h, two categories:
  * the tree's pick among area and punctual lights by their importance at the point, and the
- * environment; an emitter hit by a BSDF ray then takes its MIS weight from the tree's pdf at the
+ * environment, shared at each point by what each can bring (env_share); an emitter hit or an
+ * escape of a BSDF ray then takes its MIS weight from the tree's pdf and the shares at the
  * previous vertex), then the BSDF is sampled. max_depth bounds the number of scattering events;
  * Russian roulette (survival = min(1, sqrt(max throughput)), as Cycles does) starts at the fifth
  * bounce: on the Cornell box it cost 41 % more error per sample from the third with survival
@@ -60,6 +61,17 @@ typedef struct pt_job {
     bool has_area, has_env, has_punctual;
     const sy_rt_lighttree *lt; /* light_tree: area and punctual lights are one category, picked by the tree */
 } pt_job;
+
+/* With the light tree and an environment, the environment's share of the light samples at point p
+ * with the tree's normal n: the irradiance it can give (pi x its mean radiance) against the light
+ * the tree's top level can bring (its importances, in the same units), like the entries of that
+ * level among themselves. The tree's share is the rest. */
+static float env_share(const pt_job *j, sy_rt_v3 p, sy_rt_v3 n)
+{
+    float e = j->env.irradiance, t = sy_rt_lighttree_total_importance(j->lt, p, n);
+    float share = e / (e + t);
+    return isfinite(share) && share >= 0.0f ? sy_rt_minf(share, 1.0f) : 0.5f;
+}
 
 typedef struct pt_ctx {
     const sy_rt_frame *f;
@@ -114,7 +126,8 @@ static sy_rt_v3 eval_toward(pt_ctx *c, const sy_rt_bsdf *b, sy_rt_v3 wo, sy_rt_v
 
 /* One light sample from the shading point: returns f * Le * cos * MIS weight / pdf (visibility
  * included). */
-static sy_rt_v3 sample_light(pt_ctx *c, const sy_rt_bsdf *b, const sy_rt_surface *s, sy_rt_v3 wo, const float u[4])
+static sy_rt_v3 sample_light(pt_ctx *c, const sy_rt_bsdf *b, const sy_rt_surface *s, sy_rt_v3 wo, const float u[4],
+                             float p_env)
 {
     const pt_job *j = c->job;
     const sy_rt_device *dev = c->dev;
@@ -124,6 +137,11 @@ static sy_rt_v3 sample_light(pt_ctx *c, const sy_rt_bsdf *b, const sy_rt_surface
     if (cat >= j->categories) cat = j->categories - 1u;
     float ur = sy_rt_clampf(x - (float)cat, 0.0f, 0.99999994f);
     float p_cat = 1.0f / (float)j->categories;
+    if (j->lt && j->has_env) { /* the tree, then the environment, each by its share (env_share) */
+        float p_tree_cat = 1.0f - p_env;
+        if (u[0] < p_tree_cat) cat = 0u, ur = sy_rt_clampf(u[0] / p_tree_cat, 0.0f, 0.99999994f), p_cat = p_tree_cat;
+        else cat = 1u, ur = sy_rt_clampf((u[0] - p_tree_cat) / p_env, 0.0f, 0.99999994f), p_cat = p_env;
+    }
     /* category order: area, environment, punctual (only those present); with the light tree:
      * the tree (area and punctual), environment */
     int kind = -1;
@@ -265,6 +283,7 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
     out->albedo = out->normal = v3(0.0f, 0.0f, 0.0f);
     float p_area_sel = j->has_area ? 1.0f / (float)j->categories : 0.0f;
     float p_env_sel = j->has_env ? 1.0f / (float)j->categories : 0.0f;
+    const bool env_split = j->lt && j->has_env; /* the two shares are the previous vertex's env_share */
     /* path record: after P0 every contribution x (before the path throughput) also goes into the
      * incident estimate with the throughput beta_s gathered after P0 */
     bool after_p0 = false, want_hit = false;
@@ -397,9 +416,15 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
             if (bounce == 1u) ub[1] = dirs[2], ub[2] = dirs[3];
         }
         LAP(SY_RT_STAGE_SHADING);
+        float p_env_here = p_env_sel;
+        if (env_split) {
+            LAP(SY_RT_STAGE_LIGHT);
+            p_env_here = env_share(j, s.p, sy_rt_light_tree_normal(b.ng, b.q_trans));
+            LAP(SY_RT_STAGE_SHADING);
+        }
         if (evaluable && j->categories) {
             LAP(SY_RT_STAGE_LIGHT);
-            sy_rt_v3 le = sample_light(c, &b, &s, wo, ul);
+            sy_rt_v3 le = sample_light(c, &b, &s, wo, ul, p_env_here);
             LAP(SY_RT_STAGE_SHADING);
             sy_rt_v3 contrib = v3_mul(beta, le);
             L = v3_add(L, contrib);
@@ -421,6 +446,7 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
         specular = bs.specular;
         pdf_prev = bs.pdf;
         if (j->lt) prev_p = s.p, prev_n = sy_rt_light_tree_normal(b.ng, b.q_trans);
+        if (env_split) p_env_sel = p_env_here, p_area_sel = 1.0f - p_env_here;
         bounce++;
         if (bounce >= 5u) {
             float q = sy_rt_minf(sqrtf(maxc(beta)), 1.0f);
