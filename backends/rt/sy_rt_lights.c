@@ -192,12 +192,14 @@ sy_rt_result sy_rt_env_rebuild(sy_rt_device *dev)
     double lsum = 0.0;
     for (size_t i = 0; i < n; ++i) lsum += lum[i];
     float floor_w = (float)(lsum / (double)n * 1e-3) + 1e-12f;
+    double lum_sphere = 0.0, w_sphere = 0.0; /* the mean luminance, each row by its sin(theta) */
     for (uint32_t y = 0; y < h; ++y) {
         float s = sinf(PI_F * ((float)y + 0.5f) / (float)h);
         float *cdf = d->conditional + (size_t)y * (w + 1u);
-        double acc = 0.0;
+        double acc = 0.0, row = 0.0;
         cdf[0] = 0.0f;
         for (uint32_t x = 0; x < w; ++x) {
+            row += lum[(size_t)y * w + x];
             float m = lum[(size_t)y * w + x];
             m = fmaxf(m, lum[(size_t)y * w + (x + 1u) % w]);
             m = fmaxf(m, lum[(size_t)y * w + (x + w - 1u) % w]);
@@ -212,13 +214,9 @@ sy_rt_result sy_rt_env_rebuild(sy_rt_device *dev)
         cdf[w] = 1.0f;
         rows[y] = acc;
         total += acc;
-    }
-    double lum_sphere = 0.0, w_sphere = 0.0; /* the mean luminance, each row by its sin(theta) */
-    for (uint32_t y = 0; y < h; ++y) {
-        double s = sin(PI_F * ((double)y + 0.5) / (double)h), row = 0.0;
-        for (uint32_t x = 0; x < w; ++x) row += lum[(size_t)y * w + x];
-        lum_sphere += row * s;
-        w_sphere += (double)w * s;
+        double sd = sin(PI_F * ((double)y + 0.5) / (double)h);
+        lum_sphere += row * sd;
+        w_sphere += (double)w * sd;
     }
     d->mean_luminance = w_sphere > 0.0 ? (float)(lum_sphere / w_sphere) : 0.0f;
     double acc = 0.0;
@@ -235,7 +233,23 @@ sy_rt_result sy_rt_env_rebuild(sy_rt_device *dev)
     return SY_RT_OK;
 }
 
-static sy_rt_v3 latlong_eval(const sy_rt_texture_data *tex, float intensity, sy_rt_v3 d);
+static void dir_to_uv(sy_rt_v3 d, float *u, float *v)
+{
+    float phi = atan2f(d.x, -d.z);
+    *u = 0.5f + phi * (0.5f / PI_F);
+    *v = acosf(sy_rt_clampf(d.y, -1.0f, 1.0f)) * (1.0f / PI_F);
+}
+
+/* Lat-long lookup of a texture times intensity; non-finite or negative radiance reads as 0. */
+static sy_rt_v3 latlong_eval(const sy_rt_texture_data *tex, float intensity, sy_rt_v3 d)
+{
+    float u, v, c[4];
+    dir_to_uv(d, &u, &v);
+    sy_rt_texture_sample(tex, u, v, c);
+    sy_rt_v3 r = v3_scale(v3(c[0], c[1], c[2]), intensity);
+    return (isfinite(r.x) && isfinite(r.y) && isfinite(r.z)) ? v3(fmaxf(r.x, 0.0f), fmaxf(r.y, 0.0f), fmaxf(r.z, 0.0f))
+                                                             : v3(0.0f, 0.0f, 0.0f);
+}
 
 void sy_rt_env_get(const sy_rt_device *dev, sy_rt_env *env)
 {
@@ -256,24 +270,6 @@ void sy_rt_env_get(const sy_rt_device *dev, sy_rt_env *env)
             env->constant_radiance = latlong_eval(t, env->intensity, v3(0.0f, 0.0f, -1.0f));
         }
     }
-}
-
-static void dir_to_uv(sy_rt_v3 d, float *u, float *v)
-{
-    float phi = atan2f(d.x, -d.z);
-    *u = 0.5f + phi * (0.5f / PI_F);
-    *v = acosf(sy_rt_clampf(d.y, -1.0f, 1.0f)) * (1.0f / PI_F);
-}
-
-/* Lat-long lookup of a texture times intensity; non-finite or negative radiance reads as 0. */
-static sy_rt_v3 latlong_eval(const sy_rt_texture_data *tex, float intensity, sy_rt_v3 d)
-{
-    float u, v, c[4];
-    dir_to_uv(d, &u, &v);
-    sy_rt_texture_sample(tex, u, v, c);
-    sy_rt_v3 r = v3_scale(v3(c[0], c[1], c[2]), intensity);
-    return (isfinite(r.x) && isfinite(r.y) && isfinite(r.z)) ? v3(fmaxf(r.x, 0.0f), fmaxf(r.y, 0.0f), fmaxf(r.z, 0.0f))
-                                                             : v3(0.0f, 0.0f, 0.0f);
 }
 
 sy_rt_v3 sy_rt_env_eval(const sy_rt_env *env, sy_rt_v3 d)

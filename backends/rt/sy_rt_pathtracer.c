@@ -132,15 +132,18 @@ static sy_rt_v3 sample_light(pt_ctx *c, const sy_rt_bsdf *b, const sy_rt_surface
     const pt_job *j = c->job;
     const sy_rt_device *dev = c->dev;
     sy_rt_v3 zero = v3(0.0f, 0.0f, 0.0f);
-    float x = u[0] * (float)j->categories;
-    uint32_t cat = (uint32_t)x;
-    if (cat >= j->categories) cat = j->categories - 1u;
-    float ur = sy_rt_clampf(x - (float)cat, 0.0f, 0.99999994f);
-    float p_cat = 1.0f / (float)j->categories;
+    uint32_t cat;
+    float ur, p_cat;
     if (j->lt && j->has_env) { /* the tree, then the environment, each by its share (env_share) */
         float p_tree_cat = 1.0f - p_env;
         if (u[0] < p_tree_cat) cat = 0u, ur = sy_rt_clampf(u[0] / p_tree_cat, 0.0f, 0.99999994f), p_cat = p_tree_cat;
         else cat = 1u, ur = sy_rt_clampf((u[0] - p_tree_cat) / p_env, 0.0f, 0.99999994f), p_cat = p_env;
+    } else { /* uniformly among the categories present */
+        float x = u[0] * (float)j->categories;
+        cat = (uint32_t)x;
+        if (cat >= j->categories) cat = j->categories - 1u;
+        ur = sy_rt_clampf(x - (float)cat, 0.0f, 0.99999994f);
+        p_cat = 1.0f / (float)j->categories;
     }
     /* category order: area, environment, punctual (only those present); with the light tree:
      * the tree (area and punctual), environment */
