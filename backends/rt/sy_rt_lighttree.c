@@ -557,19 +557,25 @@ float sy_rt_lighttree_total_importance(const sy_rt_lighttree *t, sy_rt_v3 p, sy_
  * local ones marked top), each in proportion to its importance (by power where none has any).
  * With u: chooses one (*chosen, u rescaled) and returns its probability; else returns entry
  * which's probability. */
+/* top entries whose importance top_prob keeps from its sum for its choice (the rest it evaluates
+ * again) */
+#define LT_TOP_KEPT 8u
+
 static float top_prob(const sy_rt_lighttree *t, sy_rt_v3 p, sy_rt_v3 n, uint32_t which, float *u, uint32_t *chosen)
 {
     /* weights, summed in a fixed order: pick and pdf agree */
-    float s = 0.0f, ps = 0.0f;
+    float s = 0.0f, ps = 0.0f, kept[LT_TOP_KEPT];
     uint32_t k = (t->node_count ? 1u : 0u) + t->top_count;
     for (uint32_t i = 0; i < k; ++i) {
-        s += top_importance(t, i, p, n);
+        float w = top_importance(t, i, p, n);
+        if (i < LT_TOP_KEPT) kept[i] = w;
+        s += w;
         ps += top_bounds(t, i)->power;
     }
     bool by_power = !(s > 0.0f) || !isfinite(s);
     float total = by_power ? ps : s, acc = 0.0f;
     for (uint32_t i = 0; i < k; ++i) {
-        float w = by_power ? top_bounds(t, i)->power : top_importance(t, i, p, n);
+        float w = by_power ? top_bounds(t, i)->power : i < LT_TOP_KEPT ? kept[i] : top_importance(t, i, p, n);
         float pr = w / total;
         if (u) {
             if (pr > 0.0f && (*u < acc + pr || i + 1u == k)) {

@@ -73,6 +73,33 @@ static float env_share(const pt_job *j, sy_rt_v3 p, sy_rt_v3 n)
     return isfinite(share) && share >= 0.0f ? sy_rt_minf(share, 1.0f) : 0.5f;
 }
 
+/* The pixel a tile is at: its sampler seed and, for the sets below PT_SEED_SETS (the camera's and
+ * the first 15 bounces'), each set's scramble derived on its first use and kept for the pixel's
+ * other samples (the points bit for bit sy_rt_sobol_sample4's). */
+enum { PT_SEED_SETS = 32 };
+typedef struct pt_pixel {
+    uint32_t px, py, pseed;
+    uint32_t have; /* bit s: set[s] derived */
+    sy_rt_sobol_seed set[PT_SEED_SETS];
+} pt_pixel;
+
+static void pixel_start(pt_pixel *pp, const sy_rt_frame *f, uint32_t px, uint32_t py)
+{
+    pp->px = px, pp->py = py, pp->have = 0;
+    pp->pseed = sy_rt_hash32(px ^ sy_rt_hash32(py ^ sy_rt_hash32(f->seed ^ 0x5bd1e995u)));
+}
+
+/* Point index of set `set` for the pixel. */
+static inline void pixel_sample4(pt_pixel *pp, const sy_rt_sobol *sobol, uint32_t set, uint32_t index, float out[4])
+{
+    if (set >= PT_SEED_SETS) {
+        sy_rt_sobol_sample4(sobol, pp->pseed, set, index, out);
+        return;
+    }
+    if (!(pp->have >> set & 1u)) sy_rt_sobol_seed_of(sobol, pp->pseed, set, &pp->set[set]), pp->have |= 1u << set;
+    sy_rt_sobol_sample4_seeded(sobol, &pp->set[set], index, out);
+}
+
 typedef struct pt_ctx {
     const sy_rt_frame *f;
     const sy_rt_device *dev;
@@ -244,18 +271,18 @@ static void record_p0(sy_rt_pt_record *rec, const sy_rt_surface *s, const sy_rt_
 #if defined(__GNUC__)
 __attribute__((always_inline))
 #endif
-static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t index, sy_rt_pt_sample *out,
+static inline void trace_sample(pt_ctx *c, pt_pixel *pp, uint32_t index, sy_rt_pt_sample *out,
                          sy_rt_pt_record *rec, const bool timed)
 {
     const sy_rt_frame *f = c->f;
     const sy_rt_device *dev = c->dev;
     const pt_job *j = c->job;
-    uint32_t pseed = sy_rt_hash32(px ^ sy_rt_hash32(py ^ sy_rt_hash32(f->seed ^ 0x5bd1e995u)));
+    const uint32_t px = pp->px, py = pp->py, pseed = pp->pseed;
     /* set 0: the first two BSDF directions, stratified together; set 2 (the first vertex's BSDF
      * set): lobe choice, the pixel point, roulette */
     float dirs[4], first_bsdf[4];
-    sy_rt_sobol_sample4(j->sobol, pseed, 0u, index, dirs);
-    sy_rt_sobol_sample4(j->sobol, pseed, 2u, index, first_bsdf);
+    pixel_sample4(pp, j->sobol, 0u, index, dirs);
+    pixel_sample4(pp, j->sobol, 2u, index, first_bsdf);
     if (dev->motion_count || f->cam_motion) { /* motion blur: the sample's time, stratified over the pixel's samples (the
                               * first dimension of a set no bounce uses, scrambled apart); every ray
                               * of the path, shadow rays too, has it */
@@ -411,11 +438,11 @@ static inline void trace_sample(pt_ctx *c, uint32_t px, uint32_t py, uint32_t in
         }
         float ul[4], ub[4];
         LAP(SY_RT_STAGE_RNG);
-        sy_rt_sobol_sample4(j->sobol, pseed, 1u + 2u * bounce, index, ul);
+        pixel_sample4(pp, j->sobol, 1u + 2u * bounce, index, ul);
         if (bounce == 0u) {
             ub[0] = first_bsdf[0], ub[1] = dirs[0], ub[2] = dirs[1], ub[3] = first_bsdf[3];
         } else {
-            sy_rt_sobol_sample4(j->sobol, pseed, 2u + 2u * bounce, index, ub);
+            pixel_sample4(pp, j->sobol, 2u + 2u * bounce, index, ub);
             if (bounce == 1u) ub[1] = dirs[2], ub[2] = dirs[3];
         }
         LAP(SY_RT_STAGE_SHADING);
@@ -490,11 +517,13 @@ static void pt_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, 
     sy_rt_stage_clock clk_mem, *clk = NULL;
     if (j->stages && !j->records) memset(&clk_mem, 0, sizeof clk_mem), clk = &clk_mem;
     uint64_t bad = 0, timed = 0;
+    pt_pixel pp;
     for (uint32_t py = y0; py < y1; ++py)
         for (uint32_t px = x0; px < x1; ++px) {
             size_t pix = (size_t)(py - f->y) * f->width + (px - f->x);
             float *rec = j->acc->data + pix * SY_RT_ACC_STRIDE;
             sy_rt_pt_record *prec = j->records ? j->records + pix : NULL;
+            pixel_start(&pp, f, px, py);
             if (clk && sy_rt_hash32(px * 0x9e3779b1u ^ sy_rt_hash32(py)) % SY_RT_STAGE_SUBSET == 0u) {
                 /* a timed pixel (records are off while timing) */
                 c.clk = clk;
@@ -502,7 +531,7 @@ static void pt_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, 
                 clk->last = sy_rt_stage_tick();
                 for (uint32_t k = 0; k < j->count; ++k) {
                     sy_rt_pt_sample s;
-                    trace_sample(&c, px, py, j->first + k, &s, NULL, true);
+                    trace_sample(&c, &pp, j->first + k, &s, NULL, true);
                     sy_rt_stage_lap(clk, SY_RT_STAGE_ACCUM);
                     if (!sy_rt_accum_add(rec, j->first + k + 1u, &s)) bad++;
                     sy_rt_stage_lap(clk, SY_RT_STAGE_RNG);
@@ -513,8 +542,8 @@ static void pt_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t y0, 
             }
             for (uint32_t k = 0; k < j->count; ++k) {
                 sy_rt_pt_sample s;
-                if (prec && k + 1u == j->count) trace_sample(&c, px, py, j->first + k, &s, prec, false);
-                else trace_sample(&c, px, py, j->first + k, &s, NULL, false);
+                if (prec && k + 1u == j->count) trace_sample(&c, &pp, j->first + k, &s, prec, false);
+                else trace_sample(&c, &pp, j->first + k, &s, NULL, false);
                 if (!sy_rt_accum_add(rec, j->first + k + 1u, &s)) bad++;
             }
         }

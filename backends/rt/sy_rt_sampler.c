@@ -85,6 +85,9 @@ static void build_tables(sy_rt_sobol *s)
             }
 }
 
+/* The lanes' scramble seeds are the hashes of seed + d x 0x68e31da4 (d = 0..3). */
+#define LANE_STEP 0x68e31da4u
+
 #if defined(__GNUC__)
 /* The four dimensions' scrambles side by side (GCC / Clang vector extensions: SSE2 on x86-64). */
 typedef uint32_t sy_u32x4 __attribute__((vector_size(16)));
@@ -107,17 +110,26 @@ static inline sy_u32x4 reverse_bits4(sy_u32x4 x)
 #else
 #define SY_RT_SAMPLE4_CLONES __attribute__((target_clones("avx2", "sse4.1", "default")))
 #endif
-SY_RT_SAMPLE4_CLONES
-void sy_rt_sobol_sample4(const sy_rt_sobol *s, uint32_t pixel_seed, uint32_t set, uint32_t index, float out[4])
+
+/* the set's seed and the lanes' (sy_rt_hash32 of each lane's seed, side by side) */
+__attribute__((always_inline)) static inline sy_u32x4 lanes_of(const sy_rt_sobol *s, uint32_t pixel_seed, uint32_t set,
+                                                              uint32_t *seed)
 {
-    uint32_t seed = sy_rt_hash32(pixel_seed ^ set_hash_at(s, set));
+    uint32_t sd = sy_rt_hash32(pixel_seed ^ set_hash_at(s, set));
+    sy_u32x4 h = {sd, sd + LANE_STEP, sd + 2u * LANE_STEP, sd + 3u * LANE_STEP};
+    h ^= h >> 16, h *= 0x7feb352du, h ^= h >> 15, h *= 0x846ca68bu, h ^= h >> 16;
+    *seed = sd;
+    return h;
+}
+
+/* the point at index from the set's seed and the lanes' */
+__attribute__((always_inline)) static inline void point_of(const sy_rt_sobol *s, uint32_t seed, sy_u32x4 h,
+                                                          uint32_t index, float out[4])
+{
     uint32_t j = laine_karras(reverse_bits(index), seed);
     uint32_t j0 = j & 0xffu, j1 = (j >> 8) & 0xffu, j2 = (j >> 16) & 0xffu, j3 = j >> 24;
-    sy_u32x4 h = {seed, seed + 0x68e31da4u, seed + 2u * 0x68e31da4u, seed + 3u * 0x68e31da4u};
     sy_u32x4 x = *(const sy_u32x4 *)s->t[0][j0] ^ *(const sy_u32x4 *)s->t[1][j1] ^ *(const sy_u32x4 *)s->t[2][j2] ^
                  *(const sy_u32x4 *)s->t[3][j3];
-    /* sy_rt_hash32 of each lane's seed */
-    h ^= h >> 16, h *= 0x7feb352du, h ^= h >> 15, h *= 0x846ca68bu, h ^= h >> 16;
     x ^= x * 0x3d20adeau;
     x += h;
     x *= (h >> 16) | 1u;
@@ -126,15 +138,47 @@ void sy_rt_sobol_sample4(const sy_rt_sobol *s, uint32_t pixel_seed, uint32_t set
     x = reverse_bits4(x) >> 8;
     for (uint32_t d = 0; d < 4; ++d) out[d] = (float)x[d] * (1.0f / 16777216.0f);
 }
-#else
+
+SY_RT_SAMPLE4_CLONES
 void sy_rt_sobol_sample4(const sy_rt_sobol *s, uint32_t pixel_seed, uint32_t set, uint32_t index, float out[4])
 {
-    uint32_t seed = sy_rt_hash32(pixel_seed ^ set_hash_at(s, set));
-    uint32_t j = laine_karras(reverse_bits(index), seed);
+    uint32_t seed;
+    sy_u32x4 h = lanes_of(s, pixel_seed, set, &seed);
+    point_of(s, seed, h, index, out);
+}
+
+SY_RT_SAMPLE4_CLONES
+void sy_rt_sobol_seed_of(const sy_rt_sobol *s, uint32_t pixel_seed, uint32_t set, sy_rt_sobol_seed *out)
+{
+    *(sy_u32x4 *)out->lane = lanes_of(s, pixel_seed, set, &out->seed);
+}
+
+SY_RT_SAMPLE4_CLONES
+void sy_rt_sobol_sample4_seeded(const sy_rt_sobol *s, const sy_rt_sobol_seed *k, uint32_t index, float out[4])
+{
+    point_of(s, k->seed, *(const sy_u32x4 *)k->lane, index, out);
+}
+#else
+void sy_rt_sobol_seed_of(const sy_rt_sobol *s, uint32_t pixel_seed, uint32_t set, sy_rt_sobol_seed *out)
+{
+    out->seed = sy_rt_hash32(pixel_seed ^ set_hash_at(s, set));
+    for (uint32_t d = 0; d < 4; ++d) out->lane[d] = sy_rt_hash32(out->seed + d * LANE_STEP);
+}
+
+void sy_rt_sobol_sample4_seeded(const sy_rt_sobol *s, const sy_rt_sobol_seed *k, uint32_t index, float out[4])
+{
+    uint32_t j = laine_karras(reverse_bits(index), k->seed);
     for (uint32_t d = 0; d < 4; ++d) {
         uint32_t rr = s->t[0][j & 0xffu][d] ^ s->t[1][(j >> 8) & 0xffu][d] ^ s->t[2][(j >> 16) & 0xffu][d] ^ s->t[3][j >> 24][d];
-        uint32_t x = reverse_bits(laine_karras(rr, sy_rt_hash32(seed + d * 0x68e31da4u)));
+        uint32_t x = reverse_bits(laine_karras(rr, k->lane[d]));
         out[d] = (float)(x >> 8) * (1.0f / 16777216.0f);
     }
+}
+
+void sy_rt_sobol_sample4(const sy_rt_sobol *s, uint32_t pixel_seed, uint32_t set, uint32_t index, float out[4])
+{
+    sy_rt_sobol_seed k;
+    sy_rt_sobol_seed_of(s, pixel_seed, set, &k);
+    sy_rt_sobol_sample4_seeded(s, &k, index, out);
 }
 #endif

@@ -27,6 +27,19 @@ void sy_rt_sobol_init(sy_rt_sobol *s);
 /* Point `index` of the 4D set `set` for the pixel whose seed is pixel_seed; out in [0, 1)^4. */
 void sy_rt_sobol_sample4(const sy_rt_sobol *s, uint32_t pixel_seed, uint32_t set, uint32_t index, float out[4]);
 
+/* What sy_rt_sobol_sample4 derives from (pixel seed, set) before it looks at the index: the set's
+ * seed and its four dimensions' scramble seeds. A pixel that takes many samples derives it once per
+ * set (sy_rt_sobol_seed_of) and draws its points with sy_rt_sobol_sample4_seeded, which gives
+ * sy_rt_sobol_sample4's points bit for bit with two hashes fewer on each point's dependency chain.
+ * Plain data, owned by the caller. */
+typedef struct sy_rt_sobol_seed {
+    _Alignas(16) uint32_t lane[4]; /* each dimension's scramble seed */
+    uint32_t seed;                 /* the set's seed (scrambles the index) */
+} sy_rt_sobol_seed;
+
+void sy_rt_sobol_seed_of(const sy_rt_sobol *s, uint32_t pixel_seed, uint32_t set, sy_rt_sobol_seed *out);
+void sy_rt_sobol_sample4_seeded(const sy_rt_sobol *s, const sy_rt_sobol_seed *k, uint32_t index, float out[4]);
+
 /* Unscrambled 32-bit Sobol value of dimension dim (0..3) at index (tests). */
 uint32_t sy_rt_sobol_raw(const sy_rt_sobol *s, uint32_t index, uint32_t dim);
 

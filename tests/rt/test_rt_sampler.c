@@ -5,6 +5,8 @@
  *     hash(pixel seed ^ hash(set)), the index shuffled by Laine-Karras on its reversed bits, the
  *     unscrambled point at the shuffled index, each dimension Owen-scrambled with its own seed) at
  *     sets on both sides of the seed-hash table's end (SY_RT_SOBOL_SETS) and far beyond it;
+ *   - a set's scramble derived once (sy_rt_sobol_seed_of, sy_rt_sobol_sample4_seeded) gives the
+ *     same points bit for bit, at the same sets and pixels and at indices over all 32 bits;
  *   - stratification: for several pixels and sets, the first 2^k points' dimensions 0 and 1 form a
  *     (0,k,2)-net (every elementary interval of area 2^-k, for every shape, holds exactly one point)
  *     and dimensions 2 and 3 are each stratified in 2^k intervals. */
@@ -84,6 +86,25 @@ int main(void)
             }
     EXPECT_MSG(mismatches == 0, "%d of %zu points differ from the construction", mismatches,
                sizeof sets / sizeof sets[0] * (sizeof pixels / sizeof pixels[0]) * 64);
+
+    /* a set's scramble derived once (sy_rt_sobol_seed_of) gives the same points as sy_rt_sobol_sample4 */
+    int seeded_mismatches = 0;
+    for (size_t a = 0; a < sizeof sets / sizeof sets[0]; ++a)
+        for (size_t p = 0; p < sizeof pixels / sizeof pixels[0]; ++p) {
+            sy_rt_sobol_seed k;
+            sy_rt_sobol_seed_of(s, pixels[p], sets[a], &k);
+            for (uint32_t i = 0; i < 64; ++i) {
+                uint32_t index = i * 0x9e3779b9u + (uint32_t)a;
+                float got[4], want4[4];
+                sy_rt_sobol_sample4_seeded(s, &k, index, got);
+                sy_rt_sobol_sample4(s, pixels[p], sets[a], index, want4);
+                if (memcmp(got, want4, sizeof got) != 0 && seeded_mismatches++ < 5)
+                    fprintf(stderr, "FAIL: seeded set %u pixel 0x%08x index %u: (%.7f %.7f %.7f %.7f), want (%.7f %.7f %.7f %.7f)\n",
+                            sets[a], pixels[p], index, got[0], got[1], got[2], got[3], want4[0], want4[1], want4[2],
+                            want4[3]);
+            }
+        }
+    EXPECT_MSG(seeded_mismatches == 0, "%d seeded points differ from sy_rt_sobol_sample4", seeded_mismatches);
 
     /* stratification of the first 2^k points */
     for (uint32_t k = 1; k <= 8; ++k)
