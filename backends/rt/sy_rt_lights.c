@@ -279,7 +279,7 @@ sy_rt_v3 sy_rt_env_eval(const sy_rt_env *env, sy_rt_v3 d)
     return latlong_eval(env->tex, env->intensity, d);
 }
 
-float sy_rt_background_eval(const sy_rt_device *dev, sy_rt_v3 d, sy_rt_v3 *rgb)
+float sy_rt_background_eval(const sy_rt_device *dev, const sy_rt_v3 *d, sy_rt_v3 *rgb)
 {
     const sy_rt_background *bg = &dev->background;
     *rgb = v3(0.0f, 0.0f, 0.0f);
@@ -289,7 +289,7 @@ float sy_rt_background_eval(const sy_rt_device *dev, sy_rt_v3 d, sy_rt_v3 *rgb)
     }
     if (bg->mode == SY_RT_BACKGROUND_TEXTURE) {
         const sy_rt_texture_data *t = sy_rt_pool_get(&dev->textures, bg->texture.id);
-        if (t) *rgb = latlong_eval(t, bg->intensity, v3_normalize(d));
+        if (t) *rgb = latlong_eval(t, bg->intensity, v3_normalize(*d));
         return 1.0f;
     }
     return 0.0f;

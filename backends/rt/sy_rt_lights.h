@@ -46,9 +46,10 @@ typedef struct sy_rt_env {
 void sy_rt_env_get(const sy_rt_device *dev, sy_rt_env *env);
 /* Radiance arriving from direction d (unit). */
 sy_rt_v3 sy_rt_env_eval(const sy_rt_env *env, sy_rt_v3 d);
-/* The committed background along camera-ray direction d (any length): radiance in *rgb, returns
- * its alpha (0 for NONE, else 1). */
-float sy_rt_background_eval(const sy_rt_device *dev, sy_rt_v3 d, sy_rt_v3 *rgb);
+/* The committed background along camera-ray direction *d (any length): radiance in *rgb, returns
+ * its alpha (0 for NONE, else 1). (d by address: GCC built a by-value vector's first two
+ * components through the stack at the path tracer's call, and the load waited for the stores.) */
+float sy_rt_background_eval(const sy_rt_device *dev, const sy_rt_v3 *d, sy_rt_v3 *rgb);
 /* Solid-angle pdf of sampling direction d with sy_rt_env_sample. */
 float sy_rt_env_pdf(const sy_rt_env *env, sy_rt_v3 d);
 /* Samples a direction from two uniform numbers; returns its pdf (0 = failed) and radiance. */

@@ -344,7 +344,7 @@ static inline void trace_sample(pt_ctx *c, pt_pixel *pp, uint32_t index, sy_rt_p
         if (!in) {
             if (bounce == 0u) { /* a camera ray (through alpha-blended crossings) sees the background */
                 sy_rt_v3 bg;
-                float a = sy_rt_background_eval(dev, d, &bg);
+                float a = sy_rt_background_eval(dev, &d, &bg);
                 if (first) out->alpha = a;
                 sy_rt_v3 contrib = v3_mul(beta, bg);
                 L = v3_add(L, contrib);

@@ -62,8 +62,8 @@ void sy_rt_primary_tile(const sy_rt_frame *f, void *user, uint32_t x0, uint32_t 
                 const sy_rt_instance_data *in = rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID
                                                     ? NULL : sy_rt_hit_instance(dev, rh.hit.geomID[k], rh.hit.instID[0][k]);
                 if (!in) {
-                    sy_rt_v3 bg;
-                    c[3] = sy_rt_background_eval(dev, v3(rh.ray.dir_x[k], rh.ray.dir_y[k], rh.ray.dir_z[k]), &bg);
+                    sy_rt_v3 bg, d = v3(rh.ray.dir_x[k], rh.ray.dir_y[k], rh.ray.dir_z[k]);
+                    c[3] = sy_rt_background_eval(dev, &d, &bg);
                     c[0] = bg.x;
                     c[1] = bg.y;
                     c[2] = bg.z;

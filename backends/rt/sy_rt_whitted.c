@@ -1042,7 +1042,7 @@ static rgba_t trace(trace_ctx *c, sy_rt_v3 org, sy_rt_v3 dir, float tnear, float
     const sy_rt_instance_data *in = sy_rt_intersect(c->dev, ictx, org, dir, tnear, tfar, &rh);
     if (!in) {
         rgba_t r = {v3(0.0f, 0.0f, 0.0f), 0.0f};
-        if (camera) r.a = sy_rt_background_eval(c->dev, dir, &r.rgb); /* the background */
+        if (camera) r.a = sy_rt_background_eval(c->dev, &dir, &r.rgb); /* the background */
         else r.rgb = sy_rt_env_eval(&c->job->env, v3_normalize(dir)); /* the environment light */
         if (t_hit) *t_hit = INFINITY;
         return r;
