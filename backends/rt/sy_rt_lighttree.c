@@ -553,14 +553,14 @@ float sy_rt_lighttree_total_importance(const sy_rt_lighttree *t, sy_rt_v3 p, sy_
     return s;
 }
 
-/* The top level: the root (when there is a tree), then the lights beside it (directional ones and
- * local ones marked top), each in proportion to its importance (by power where none has any).
- * With u: chooses one (*chosen, u rescaled) and returns its probability; else returns entry
- * which's probability. */
 /* top entries whose importance top_prob keeps from its sum for its choice (the rest it evaluates
  * again) */
 #define LT_TOP_KEPT 8u
 
+/* The top level: the root (when there is a tree), then the lights beside it (directional ones and
+ * local ones marked top), each in proportion to its importance (by power where none has any).
+ * With u: chooses one (*chosen, u rescaled) and returns its probability; else returns entry
+ * which's probability. */
 static float top_prob(const sy_rt_lighttree *t, sy_rt_v3 p, sy_rt_v3 n, uint32_t which, float *u, uint32_t *chosen)
 {
     /* weights, summed in a fixed order: pick and pdf agree */
