@@ -112,7 +112,7 @@ static void fetch(const sy_rt_texture_data *t, uint32_t x, uint32_t y, float out
     }
     if (t->format == SY_RT_TEXEL_FLOAT32 && t->channels >= 3) { /* RGB(A) float: environments, HDR images */
         /* loads written out: the loop below, for floats a copy of `channels` values, is what GCC
-         * turns into a call of memmove per texel (4 a bilinear sample) */
+         * turns into a memcpy call per texel (4 a bilinear sample) */
         const float *p = (const float *)t->pixels + base;
         out[0] = p[0], out[1] = p[1], out[2] = p[2];
         out[3] = t->channels == 4 ? p[3] : 1.0f;
