@@ -37,7 +37,7 @@ bool sy_rt_clip_cap(const sy_rt_device *dev, const sy_rt_instance_data *in, unsi
     for (uint32_t c = 0; c < dev->clip_count; ++c) {
         const float *q = dev->clip_planes[c];
         float s0 = q[0] * org.x + q[1] * org.y + q[2] * org.z + q[3], ds = q[0] * dir.x + q[1] * dir.y + q[2] * dir.z;
-        if (ds > 0.0f) t_enter = fmaxf(t_enter, -s0 / ds); /* crosses from the cut side into the kept one */
+        if (ds > 0.0f) t_enter = sy_rt_maxf(-s0 / ds, t_enter); /* crosses from the cut side into the kept one */
     }
     if (!(t_enter > tnear && t_enter < thit)) return false;
     /* back face: the world triangle's winding normal (counter-clockwise front; a mirroring placement

@@ -247,7 +247,7 @@ static sy_rt_v3 latlong_eval(const sy_rt_texture_data *tex, float intensity, sy_
     dir_to_uv(d, &u, &v);
     sy_rt_texture_sample(tex, u, v, c);
     sy_rt_v3 r = v3_scale(v3(c[0], c[1], c[2]), intensity);
-    return (isfinite(r.x) && isfinite(r.y) && isfinite(r.z)) ? v3(fmaxf(r.x, 0.0f), fmaxf(r.y, 0.0f), fmaxf(r.z, 0.0f))
+    return (isfinite(r.x) && isfinite(r.y) && isfinite(r.z)) ? v3(sy_rt_maxf(r.x, 0.0f), sy_rt_maxf(r.y, 0.0f), sy_rt_maxf(r.z, 0.0f))
                                                              : v3(0.0f, 0.0f, 0.0f);
 }
 
@@ -308,7 +308,7 @@ float sy_rt_env_pdf(const sy_rt_env *env, sy_rt_v3 d)
         if (x >= e->width) x = e->width - 1u;
         if (y >= e->height) y = e->height - 1u;
     }
-    float st = sqrtf(fmaxf(0.0f, 1.0f - d.y * d.y)); /* sin(theta) of d itself: the density in u, v is uniform */
+    float st = sqrtf(sy_rt_maxf(1.0f - d.y * d.y, 0.0f)); /* sin(theta) of d itself: the density in u, v is uniform */
     if (!(st > 0.0f)) return 0.0f;
     /* texel solid angle = (2 pi / w) (pi / h) sin(theta) */
     return e->texel_pdf[(size_t)y * e->width + x] * (float)e->width * (float)e->height / (2.0f * PI_F * PI_F * st);

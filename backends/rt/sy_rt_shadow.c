@@ -40,7 +40,7 @@ sy_rt_v3 sy_rt_shadow_transmittance(const sy_rt_device *dev, struct RTCIntersect
         return clear ? one : zero;
     }
     sy_rt_v3 T = one;
-    float tnear = 0.0f, inv_len = 1.0f / fmaxf(v3_length(dir), 1e-30f);
+    float tnear = 0.0f, inv_len = 1.0f / sy_rt_maxf(v3_length(dir), 1e-30f);
     const sy_rt_material_data *medium = NULL; /* the absorbing volume entered (KHR_materials_volume) */
     float t_enter = 0.0f;
     for (uint32_t k = 0; k <= MAX_CROSSINGS; ++k) {

@@ -660,9 +660,9 @@ static bool sample_tri(const sy_rt_area_tri *t, sy_rt_v3 x, float u1, float u2, 
                 float k1 = cphi + ca, k2 = sphi - sa * v3_dot(a, b);
                 float cbp = (k2 + (k2 * cphi - k1 * sphi) * ca) / ((k2 * sphi + k1 * cphi) * sa);
                 cbp = sy_rt_clampf(isfinite(cbp) ? cbp : 1.0f, -1.0f, 1.0f);
-                float sbp = sqrtf(fmaxf(0.0f, 1.0f - cbp * cbp));
+                float sbp = sqrtf(sy_rt_maxf(1.0f - cbp * cbp, 0.0f));
                 sy_rt_v3 cp = v3_add(v3_scale(a, cbp), v3_scale(v3_normalize(gram_schmidt(c, a)), sbp));
-                float ct = 1.0f - u2 * (1.0f - v3_dot(cp, b)), st = sqrtf(fmaxf(0.0f, 1.0f - ct * ct));
+                float ct = 1.0f - u2 * (1.0f - v3_dot(cp, b)), st = sqrtf(sy_rt_maxf(1.0f - ct * ct, 0.0f));
                 sy_rt_v3 d = v3_add(v3_scale(b, ct), v3_scale(v3_normalize(gram_schmidt(cp, b)), st));
                 float tt = h / v3_dot(d, t->normal); /* the distance to the plane along d */
                 if (isfinite(tt) && tt > 0.0f && isfinite(d.x + d.y + d.z)) {
@@ -962,7 +962,7 @@ static rgba_t shade(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 d, uint32_t d
             if (c->job->n_env) L = v3_add(L, direct_env(c, s, &b, model && c->job->env.filter ? &am : NULL, p_out, wo, depth));
         }
         bool recurse = depth + 1u < c->f->max_depth;
-        float cos_o = fmaxf(v3_dot(s->ns, wo), 0.0f);
+        float cos_o = sy_rt_maxf(v3_dot(s->ns, wo), 0.0f);
         if (recurse && b.delta) { /* the path tracer's delta lobes: a perfect mirror */
             sy_rt_v3 w = v3_scale(s->base, s->metallic);
             float fd = (1.0f - s->metallic) * (1.0f - s->transmission);
@@ -982,7 +982,7 @@ static rgba_t shade(trace_ctx *c, const sy_rt_surface *s, sy_rt_v3 d, uint32_t d
         }
         if (recurse && b.cc > 0.0f && b.cc_delta) { /* a smooth clearcoat: its mirror ray (F0 0.04) */
             sy_rt_v3 nc = b.cc_n ? b.ncc : s->ns; /* the coat's own normal */
-            float w = b.cc * schlick(v3(0.04f, 0.04f, 0.04f), b.cc_n ? fmaxf(v3_dot(nc, wo), 0.0f) : cos_o).x;
+            float w = b.cc * schlick(v3(0.04f, 0.04f, 0.04f), b.cc_n ? sy_rt_maxf(v3_dot(nc, wo), 0.0f) : cos_o).x;
             sy_rt_v3 r = reflect(d, nc);
             if (v3_dot(r, s->ng_facing) > 0.0f) L = v3_add(L, v3_scale(trace_secondary(c, p_out, r, depth + 1u), w));
         }
