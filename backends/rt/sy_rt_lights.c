@@ -247,8 +247,8 @@ static sy_rt_v3 latlong_eval(const sy_rt_texture_data *tex, float intensity, sy_
     dir_to_uv(d, &u, &v);
     sy_rt_texture_sample(tex, u, v, c);
     sy_rt_v3 r = v3_scale(v3(c[0], c[1], c[2]), intensity);
-    return (isfinite(r.x) && isfinite(r.y) && isfinite(r.z)) ? v3(sy_rt_maxf(r.x, 0.0f), sy_rt_maxf(r.y, 0.0f), sy_rt_maxf(r.z, 0.0f))
-                                                             : v3(0.0f, 0.0f, 0.0f);
+    if (!(isfinite(r.x) && isfinite(r.y) && isfinite(r.z))) return v3(0.0f, 0.0f, 0.0f);
+    return v3(sy_rt_maxf(r.x, 0.0f), sy_rt_maxf(r.y, 0.0f), sy_rt_maxf(r.z, 0.0f));
 }
 
 void sy_rt_env_get(const sy_rt_device *dev, sy_rt_env *env)
