@@ -70,7 +70,7 @@ static sy_rt_v3 sample_vndf(float ax, float ay, sy_rt_v3 wo, float u1, float u2)
     sy_rt_sincos_2pi(u2, &sp, &cp);
     float p1 = r * cp, p2 = r * sp;
     float s = 0.5f * (1.0f + vh.z);
-    p2 = (1.0f - s) * sqrtf(sy_rt_maxf(1.0f - p1 * p1, 0.0f)) + s * p2;
+    p2 = (1.0f - s) * sy_rt_sin_of_cos(p1) + s * p2;
     sy_rt_v3 nh = v3_add(v3_add(v3_scale(t1, p1), v3_scale(t2, p2)), v3_scale(vh, sqrtf(sy_rt_maxf(1.0f - p1 * p1 - p2 * p2, 0.0f))));
     return v3_normalize(v3(ax * nh.x, ay * nh.y, sy_rt_maxf(nh.z, 1e-7f)));
 }

@@ -308,7 +308,7 @@ float sy_rt_env_pdf(const sy_rt_env *env, sy_rt_v3 d)
         if (x >= e->width) x = e->width - 1u;
         if (y >= e->height) y = e->height - 1u;
     }
-    float st = sqrtf(sy_rt_maxf(1.0f - d.y * d.y, 0.0f)); /* sin(theta) of d itself: the density in u, v is uniform */
+    float st = sy_rt_sin_of_cos(d.y); /* sin(theta) of d itself: the density in u, v is uniform */
     if (!(st > 0.0f)) return 0.0f;
     /* texel solid angle = (2 pi / w) (pi / h) sin(theta) */
     return e->texel_pdf[(size_t)y * e->width + x] * (float)e->width * (float)e->height / (2.0f * PI_F * PI_F * st);

@@ -104,12 +104,12 @@ float sy_rt_lighttree_importance(const sy_rt_lt_bounds *b, sy_rt_v3 p, sy_rt_v3 
          * radius seen from p, is subtracted from each angle as a bound */
         float inv_d = 1.0f / sqrtf(d2);
         sy_rt_v3 wp = v3_scale(v, inv_d); /* from the light toward p */
-        float sin_u = sy_rt_minf(sqrtf(r2) * inv_d, 1.0f), cos_u = sqrtf(sy_rt_maxf(1.0f - sin_u * sin_u, 0.0f));
+        float sin_u = sy_rt_minf(sqrtf(r2) * inv_d, 1.0f), cos_u = sy_rt_sin_of_cos(sin_u);
         /* emission: theta' = theta - theta_o - theta_u, clamped at 0 */
         if (b->theta_o < PI_F) {
             float ct = sy_rt_clampf(v3_dot(v3_load(b->axis), wp), -1.0f, 1.0f);
             if (ct < b->cos_o) { /* theta > theta_o */
-                float st = sqrtf(sy_rt_maxf(1.0f - ct * ct, 0.0f));
+                float st = sy_rt_sin_of_cos(ct);
                 float c1 = ct * b->cos_o + st * b->sin_o, s1 = st * b->cos_o - ct * b->sin_o; /* of theta - theta_o */
                 if (c1 < cos_u) { /* theta - theta_o > theta_u */
                     float c2 = c1 * cos_u + s1 * sin_u;
@@ -122,7 +122,7 @@ float sy_rt_lighttree_importance(const sy_rt_lt_bounds *b, sy_rt_v3 p, sy_rt_v3 
         if (!v3_is_zero(n)) {
             float cti = sy_rt_clampf(-v3_dot(n, wp), -1.0f, 1.0f);
             if (cti < cos_u) {
-                float sti = sqrtf(sy_rt_maxf(1.0f - cti * cti, 0.0f));
+                float sti = sy_rt_sin_of_cos(cti);
                 float c2 = cti * cos_u + sti * sin_u;
                 if (c2 <= 0.0f) return 0.0f;
                 ci = c2;

@@ -55,6 +55,8 @@ static inline float sy_rt_clampf(float v, float lo, float hi) { return v < lo ? 
  * gives b, so pass the fallback (a constant) as b. */
 static inline float sy_rt_maxf(float a, float b) { return a > b ? a : b; }
 static inline float sy_rt_minf(float a, float b) { return a < b ? a : b; }
+/* sin from cos (or cos from sin): sqrt(1 - c^2), 0 where rounding takes 1 - c^2 below 0 (and for a NaN c) */
+static inline float sy_rt_sin_of_cos(float c) { return sqrtf(sy_rt_maxf(1.0f - c * c, 0.0f)); }
 static inline float v3_max_abs(sy_rt_v3 a) { return sy_rt_maxf(fabsf(a.x), sy_rt_maxf(fabsf(a.y), fabsf(a.z))); }
 static inline float sy_rt_ray_eps(sy_rt_v3 p) { return 1e-4f * (1.0f + v3_max_abs(p)); }
 /* The shadow segment from a ray origin o (a shading point offset along its normal) to a point q

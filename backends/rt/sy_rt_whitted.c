@@ -660,9 +660,9 @@ static bool sample_tri(const sy_rt_area_tri *t, sy_rt_v3 x, float u1, float u2, 
                 float k1 = cphi + ca, k2 = sphi - sa * v3_dot(a, b);
                 float cbp = (k2 + (k2 * cphi - k1 * sphi) * ca) / ((k2 * sphi + k1 * cphi) * sa);
                 cbp = sy_rt_clampf(isfinite(cbp) ? cbp : 1.0f, -1.0f, 1.0f);
-                float sbp = sqrtf(sy_rt_maxf(1.0f - cbp * cbp, 0.0f));
+                float sbp = sy_rt_sin_of_cos(cbp);
                 sy_rt_v3 cp = v3_add(v3_scale(a, cbp), v3_scale(v3_normalize(gram_schmidt(c, a)), sbp));
-                float ct = 1.0f - u2 * (1.0f - v3_dot(cp, b)), st = sqrtf(sy_rt_maxf(1.0f - ct * ct, 0.0f));
+                float ct = 1.0f - u2 * (1.0f - v3_dot(cp, b)), st = sy_rt_sin_of_cos(ct);
                 sy_rt_v3 d = v3_add(v3_scale(b, ct), v3_scale(v3_normalize(gram_schmidt(cp, b)), st));
                 float tt = h / v3_dot(d, t->normal); /* the distance to the plane along d */
                 if (isfinite(tt) && tt > 0.0f && isfinite(d.x + d.y + d.z)) {
