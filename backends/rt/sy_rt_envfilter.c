@@ -29,15 +29,8 @@ typedef struct mip_chain {
 
 static sy_rt_v3 uv_to_dir(float u, float v)
 {
-    float phi = (u - 0.5f) * 2.0f * PI_F, theta = v * PI_F;
-    float st = sinf(theta);
-    return v3(st * sinf(phi), cosf(theta), -st * cosf(phi));
-}
-
-void sy_rt_envf_uv(sy_rt_v3 d, float *u, float *v)
-{
-    *u = 0.5f + atan2f(d.x, -d.z) * (0.5f / PI_F);
-    *v = acosf(sy_rt_clampf(d.y, -1.0f, 1.0f)) * (1.0f / PI_F);
+    float st;
+    return sy_rt_latlong_dir(u, v, &st);
 }
 
 sy_rt_v3 sy_rt_envf_lookup_uv(const sy_rt_envf_map *m, float u, float v)
@@ -59,7 +52,7 @@ sy_rt_v3 sy_rt_envf_lookup_uv(const sy_rt_envf_map *m, float u, float v)
 sy_rt_v3 sy_rt_envf_lookup(const sy_rt_envf_map *m, sy_rt_v3 d)
 {
     float u, v;
-    sy_rt_envf_uv(d, &u, &v);
+    sy_rt_latlong_uv(d, &u, &v);
     return sy_rt_envf_lookup_uv(m, u, v);
 }
 
@@ -144,7 +137,7 @@ static sy_rt_v3 chain_lookup(const mip_chain *c, sy_rt_v3 d, float lod)
     uint32_t l0 = (uint32_t)lod;
     float t = lod - (float)l0;
     float u, v;
-    sy_rt_envf_uv(d, &u, &v);
+    sy_rt_latlong_uv(d, &u, &v);
     sy_rt_v3 a = sy_rt_envf_lookup_uv(&c->m[l0], u, v);
     if (t <= 0.0f || l0 + 1u >= c->n) return a;
     return v3_add(v3_scale(a, 1.0f - t), v3_scale(sy_rt_envf_lookup_uv(&c->m[l0 + 1u], u, v), t));

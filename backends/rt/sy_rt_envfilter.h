@@ -31,8 +31,7 @@ void sy_rt_envfilter_free(sy_rt_envfilter *f);
 
 /* Bilinear look-up of map m in direction d (unit): u wraps, v clamps. */
 sy_rt_v3 sy_rt_envf_lookup(const sy_rt_envf_map *m, sy_rt_v3 d);
-/* The same in two steps: the lat-long coordinates of d, then the look-up (several maps, one d). */
-void sy_rt_envf_uv(sy_rt_v3 d, float *u, float *v);
+/* The same with d's lat-long coordinates (sy_rt_latlong_uv) given (several maps, one d). */
 sy_rt_v3 sy_rt_envf_lookup_uv(const sy_rt_envf_map *m, float u, float v);
 
 #endif /* SY_RT_ENVFILTER_H */

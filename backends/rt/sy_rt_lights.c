@@ -233,22 +233,22 @@ sy_rt_result sy_rt_env_rebuild(sy_rt_device *dev)
     return SY_RT_OK;
 }
 
-static void dir_to_uv(sy_rt_v3 d, float *u, float *v)
+/* Lat-long lookup of a texture at u, v (sy_rt_latlong_uv) times intensity; non-finite or negative
+ * radiance reads as 0. */
+static sy_rt_v3 latlong_eval_uv(const sy_rt_texture_data *tex, float intensity, float u, float v)
 {
-    float phi = atan2f(d.x, -d.z);
-    *u = 0.5f + phi * (0.5f / PI_F);
-    *v = acosf(sy_rt_clampf(d.y, -1.0f, 1.0f)) * (1.0f / PI_F);
-}
-
-/* Lat-long lookup of a texture times intensity; non-finite or negative radiance reads as 0. */
-static sy_rt_v3 latlong_eval(const sy_rt_texture_data *tex, float intensity, sy_rt_v3 d)
-{
-    float u, v, c[4];
-    dir_to_uv(d, &u, &v);
+    float c[4];
     sy_rt_texture_sample(tex, u, v, c);
     sy_rt_v3 r = v3_scale(v3(c[0], c[1], c[2]), intensity);
     if (!(isfinite(r.x) && isfinite(r.y) && isfinite(r.z))) return v3(0.0f, 0.0f, 0.0f);
     return v3(sy_rt_maxf(r.x, 0.0f), sy_rt_maxf(r.y, 0.0f), sy_rt_maxf(r.z, 0.0f));
+}
+
+static sy_rt_v3 latlong_eval(const sy_rt_texture_data *tex, float intensity, sy_rt_v3 d)
+{
+    float u, v;
+    sy_rt_latlong_uv(d, &u, &v);
+    return latlong_eval_uv(tex, intensity, u, v);
 }
 
 void sy_rt_env_get(const sy_rt_device *dev, sy_rt_env *env)
@@ -279,6 +279,13 @@ sy_rt_v3 sy_rt_env_eval(const sy_rt_env *env, sy_rt_v3 d)
     return latlong_eval(env->tex, env->intensity, d);
 }
 
+sy_rt_v3 sy_rt_env_eval_uv(const sy_rt_env *env, float u, float v)
+{
+    if (env->mode != 2) return v3(0.0f, 0.0f, 0.0f);
+    if (env->constant) return env->constant_radiance;
+    return latlong_eval_uv(env->tex, env->intensity, u, v);
+}
+
 float sy_rt_background_eval(const sy_rt_device *dev, const sy_rt_v3 *d, sy_rt_v3 *rgb)
 {
     const sy_rt_background *bg = &dev->background;
@@ -295,14 +302,12 @@ float sy_rt_background_eval(const sy_rt_device *dev, const sy_rt_v3 *d, sy_rt_v3
     return 0.0f;
 }
 
-float sy_rt_env_pdf(const sy_rt_env *env, sy_rt_v3 d)
+/* the solid-angle pdf of sy_rt_env_sample's direction d, of lat-long coordinates u, v (not read
+ * for a 1x1 distribution) */
+static float env_pdf_uv(const sy_rt_env_dist *e, sy_rt_v3 d, float u, float v)
 {
-    if (env->mode != 2) return 0.0f;
-    const sy_rt_env_dist *e = env->dist;
-    uint32_t x = 0u, y = 0u; /* a 1x1 distribution has one texel: no need for the direction's u, v */
+    uint32_t x = 0u, y = 0u; /* a 1x1 distribution has one texel */
     if (e->width > 1u || e->height > 1u) {
-        float u, v;
-        dir_to_uv(d, &u, &v);
         x = (uint32_t)(u * (float)e->width);
         y = (uint32_t)(v * (float)e->height);
         if (x >= e->width) x = e->width - 1u;
@@ -314,15 +319,29 @@ float sy_rt_env_pdf(const sy_rt_env *env, sy_rt_v3 d)
     return e->texel_pdf[(size_t)y * e->width + x] * (float)e->width * (float)e->height / (2.0f * PI_F * PI_F * st);
 }
 
+float sy_rt_env_pdf(const sy_rt_env *env, sy_rt_v3 d)
+{
+    if (env->mode != 2) return 0.0f;
+    const sy_rt_env_dist *e = env->dist;
+    float u = 0.0f, v = 0.0f; /* a 1x1 distribution has one texel: no need for the direction's u, v */
+    if (e->width > 1u || e->height > 1u) sy_rt_latlong_uv(d, &u, &v);
+    return env_pdf_uv(e, d, u, v);
+}
+
+sy_rt_v3 sy_rt_env_eval_pdf(const sy_rt_env *env, sy_rt_v3 d, float *pdf)
+{
+    if (env->mode != 2) return *pdf = 0.0f, v3(0.0f, 0.0f, 0.0f);
+    if (env->constant) return *pdf = sy_rt_env_pdf(env, d), env->constant_radiance;
+    float u, v;
+    sy_rt_latlong_uv(d, &u, &v);
+    *pdf = env_pdf_uv(env->dist, d, u, v);
+    return latlong_eval_uv(env->tex, env->intensity, u, v);
+}
+
 /* Index i with cdf[i] <= u < cdf[i+1] in a CDF of n + 1 entries. */
 static uint32_t cdf_find(const float *cdf, uint32_t n, float u)
 {
-    uint32_t lo = 0, hi = n;
-    while (lo + 1u < hi) {
-        uint32_t mid = (lo + hi) / 2u;
-        if (cdf[mid] <= u) lo = mid;
-        else hi = mid;
-    }
+    uint32_t lo = sy_rt_cdf_last_le(cdf, n, u);
     while (lo + 1u < n && !(cdf[lo + 1u] > cdf[lo])) ++lo; /* skip empty cells */
     return lo;
 }
@@ -338,12 +357,11 @@ float sy_rt_env_sample(const sy_rt_env *env, float u1, float u2, sy_rt_v3 *d, sy
     float fy = dy > 0.0f ? (u2 - e->marginal[y]) / dy : 0.5f, fx = dx > 0.0f ? (u1 - row[x]) / dx : 0.5f;
     float u = ((float)x + sy_rt_clampf(fx, 0.0f, 1.0f)) / (float)e->width;
     float v = ((float)y + sy_rt_clampf(fy, 0.0f, 1.0f)) / (float)e->height;
-    float theta = v * PI_F, phi = (u - 0.5f) * 2.0f * PI_F;
-    float st = sinf(theta);
+    float st;
+    sy_rt_v3 dir = sy_rt_latlong_dir(u, v, &st);
     if (!(st > 0.0f)) return 0.0f;
-    /* inverse of dir_to_uv: phi = atan2(x, -z) */
-    *d = v3(st * sinf(phi), cosf(theta), -st * cosf(phi));
-    *radiance = sy_rt_env_eval(env, *d);
+    *d = dir;
+    *radiance = sy_rt_env_eval_uv(env, u, v); /* at u, v itself: no round trip through dir */
     return e->texel_pdf[(size_t)y * e->width + x] * (float)e->width * (float)e->height / (2.0f * PI_F * PI_F * st);
 }
 

@@ -46,6 +46,11 @@ typedef struct sy_rt_env {
 void sy_rt_env_get(const sy_rt_device *dev, sy_rt_env *env);
 /* Radiance arriving from direction d (unit). */
 sy_rt_v3 sy_rt_env_eval(const sy_rt_env *env, sy_rt_v3 d);
+/* The same at lat-long coordinates u, v (sy_rt_latlong_uv of the direction). */
+sy_rt_v3 sy_rt_env_eval_uv(const sy_rt_env *env, float u, float v);
+/* sy_rt_env_eval and sy_rt_env_pdf of one direction at once (its lat-long coordinates computed once):
+ * returns the radiance, *pdf the pdf. */
+sy_rt_v3 sy_rt_env_eval_pdf(const sy_rt_env *env, sy_rt_v3 d, float *pdf);
 /* The committed background along camera-ray direction *d (any length): radiance in *rgb, returns
  * its alpha (0 for NONE, else 1). (d by address: GCC built a by-value vector's first two
  * components through the stack at the path tracer's call, and the load waited for the stores.) */

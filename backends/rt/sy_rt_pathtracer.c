@@ -350,8 +350,9 @@ static inline void trace_sample(pt_ctx *c, pt_pixel *pp, uint32_t index, sy_rt_p
                 L = v3_add(L, contrib);
                 direct = v3_add(direct, contrib);
             } else if (j->env.mode) { /* every other ray sees the environment light */
-                sy_rt_v3 le = sy_rt_env_eval(&j->env, d);
-                float w = specular ? 1.0f : power_heuristic(pdf_prev, sy_rt_env_pdf(&j->env, d) * p_env_sel);
+                float pdf_env;
+                sy_rt_v3 le = sy_rt_env_eval_pdf(&j->env, d, &pdf_env);
+                float w = specular ? 1.0f : power_heuristic(pdf_prev, pdf_env * p_env_sel);
                 sy_rt_v3 contrib = v3_scale(v3_mul(beta, le), w);
                 L = v3_add(L, contrib);
                 if (after_p0) incident = v3_add(incident, v3_scale(v3_mul(beta_s, le), w));

@@ -539,10 +539,10 @@ static sy_rt_v3 spec_env(const sy_rt_env *env, sy_rt_v3 d, float rough)
     uint32_t k = (uint32_t)lv;
     if (k > SY_RT_ENVF_LEVELS - 2) k = SY_RT_ENVF_LEVELS - 2;
     float t = lv - (float)k, u, v;
-    sy_rt_envf_uv(d, &u, &v);
+    sy_rt_latlong_uv(d, &u, &v);
     sy_rt_v3 b = sy_rt_envf_lookup_uv(&ef->spec[k + 1u], u, v);
     if (k == 0) /* between the map itself and the first level */
-        return v3_add(v3_scale(sy_rt_env_eval(env, d), 1.0f - t), v3_scale(b, t * env->intensity));
+        return v3_add(v3_scale(sy_rt_env_eval_uv(env, u, v), 1.0f - t), v3_scale(b, t * env->intensity));
     return v3_scale(v3_add(v3_scale(sy_rt_envf_lookup_uv(&ef->spec[k], u, v), 1.0f - t), v3_scale(b, t)), env->intensity);
 }
 
@@ -647,9 +647,10 @@ static bool sample_tri(const sy_rt_area_tri *t, sy_rt_v3 x, float u1, float u2, 
         sy_rt_v3 nab = v3_cross(a, b), nca = v3_cross(c, a);
         float lab = v3_length(nab), lca = v3_length(nca);
         /* the solid angle (spherical excess) by Van Oosterom and Strackee's tan(E / 2) = |a . (b x c)| /
-         * (1 + a.b + b.c + c.a): one atan2f, and exact for small triangles where the sum of the three
+         * (1 + a.b + b.c + c.a): one atan2, and exact for small triangles where the sum of the three
          * angles minus pi loses its digits */
-        float area_sa = 2.0f * atan2f(fabsf(v3_dot(a, v3_cross(b, c))), 1.0f + v3_dot(a, b) + v3_dot(b, c) + v3_dot(c, a));
+        float tan_num = fabsf(v3_dot(a, v3_cross(b, c))), tan_den = 1.0f + v3_dot(a, b) + v3_dot(b, c) + v3_dot(c, a);
+        float area_sa = 2.0f * sy_rt_atan2f(tan_num, tan_den);
         if (lab > 1e-6f && lca > 1e-6f) {
             /* alpha, the angle at a: between the planes (a, b) and (a, c) */
             float ca = sy_rt_clampf(-v3_dot(nab, nca) / (lab * lca), -1.0f, 1.0f), sa = sqrtf(1.0f - ca * ca);
@@ -742,8 +743,7 @@ static sy_rt_v3 direct_area_analytic(trace_ctx *c, const sy_rt_surface *s, const
         if (k < n) light_u(c, SET_AREA(depth), n, k, u);
         else sy_rt_sobol_sample4(c->job->sobol, c->pseed ^ 0x5bd1e995u, SET_AREA(depth), c->sample * RETRIES + (k - n), u);
         float xi = u[0] * total;
-        uint32_t i = 0; /* the last i below nt with cdf[i] <= xi (binary search; a select, not a branch) */
-        for (uint32_t len = nt; len > 1u; len -= len / 2u) i = cdf[i + len / 2u] <= xi ? i + len / 2u : i;
+        uint32_t i = sy_rt_cdf_last_le(cdf, nt, xi);
         float p_sel = (cdf[i + 1u] - cdf[i]) / total;
         if (!(p_sel > 0.0f)) continue;
         /* one of the polygon's triangles by solid angle (u[0] rescaled), a direction uniform in
@@ -819,9 +819,10 @@ SY_WHITTED_COLD static sy_rt_v3 direct_env(trace_ctx *c, const sy_rt_surface *s,
         sy_rt_bsdf_sample bs;
         if (sy_rt_bsdf_sample_dir(b, wo, ub, &bs) && !bs.specular && !bs.transmit && bs.pdf > 0.0f &&
             v3_dot(s->ng_facing, bs.wi) > 0.0f) {
-            sy_rt_v3 lb = sy_rt_env_eval(env, bs.wi);
+            float pdf_env;
+            sy_rt_v3 lb = sy_rt_env_eval_pdf(env, bs.wi, &pdf_env);
             if (!v3_is_zero(lb)) {
-                sy_rt_v3 e = v3_scale(v3_mul(bs.weight, lb), power_heuristic(bs.pdf, sy_rt_env_pdf(env, bs.wi)));
+                sy_rt_v3 e = v3_scale(v3_mul(bs.weight, lb), power_heuristic(bs.pdf, pdf_env));
                 den = v3_add(den, e);
                 sy_rt_v3 tr = shadow(c, p_off, bs.wi, INFINITY);
                 if (!v3_is_zero(tr)) sum = v3_add(sum, v3_mul(e, tr));
