@@ -141,6 +141,8 @@ void sy_rt_env_free(sy_rt_device *dev)
         free(dev->env_dist->marginal);
         free(dev->env_dist->conditional);
         free(dev->env_dist->texel_pdf);
+        free(dev->env_dist->guide_marginal);
+        free(dev->env_dist->guide_conditional);
         free(dev->env_dist);
     }
     dev->env_dist = NULL;
@@ -165,8 +167,11 @@ sy_rt_result sy_rt_env_rebuild(sy_rt_device *dev)
         d->marginal = malloc(((size_t)h + 1u) * sizeof *d->marginal);
         d->conditional = malloc((size_t)h * ((size_t)w + 1u) * sizeof *d->conditional);
         d->texel_pdf = malloc(n * sizeof *d->texel_pdf);
+        d->guide_marginal = malloc((size_t)h * sizeof *d->guide_marginal);
+        d->guide_conditional = malloc(n * sizeof *d->guide_conditional);
     }
-    if (!d || !lum || !d->marginal || !d->conditional || !d->texel_pdf) {
+    if (!d || !lum || !d->marginal || !d->conditional || !d->texel_pdf || !d->guide_marginal ||
+        !d->guide_conditional) {
         free(lum);
         dev->env_dist = d;
         sy_rt_env_free(dev);
@@ -227,6 +232,9 @@ sy_rt_result sy_rt_env_rebuild(sy_rt_device *dev)
     }
     d->marginal[h] = 1.0f;
     for (size_t i = 0; i < n; ++i) d->texel_pdf[i] = (float)(d->texel_pdf[i] / total);
+    sy_rt_cdf_guide(d->marginal, h, d->guide_marginal);
+    for (uint32_t y = 0; y < h; ++y)
+        sy_rt_cdf_guide(d->conditional + (size_t)y * (w + 1u), w, d->guide_conditional + (size_t)y * w);
     free(rows);
     free(lum);
     dev->env_dist = d;
@@ -338,21 +346,13 @@ sy_rt_v3 sy_rt_env_eval_pdf(const sy_rt_env *env, sy_rt_v3 d, float *pdf)
     return latlong_eval_uv(env->tex, env->intensity, u, v);
 }
 
-/* Index i with cdf[i] <= u < cdf[i+1] in a CDF of n + 1 entries. */
-static uint32_t cdf_find(const float *cdf, uint32_t n, float u)
-{
-    uint32_t lo = sy_rt_cdf_last_le(cdf, n, u);
-    while (lo + 1u < n && !(cdf[lo + 1u] > cdf[lo])) ++lo; /* skip empty cells */
-    return lo;
-}
-
 float sy_rt_env_sample(const sy_rt_env *env, float u1, float u2, sy_rt_v3 *d, sy_rt_v3 *radiance)
 {
     if (env->mode != 2) return 0.0f;
     const sy_rt_env_dist *e = env->dist;
-    uint32_t y = cdf_find(e->marginal, e->height, u2);
+    uint32_t y = sy_rt_cdf_find(e->marginal, e->guide_marginal, e->height, u2);
     const float *row = e->conditional + (size_t)y * (e->width + 1u);
-    uint32_t x = cdf_find(row, e->width, u1);
+    uint32_t x = sy_rt_cdf_find(row, e->guide_conditional + (size_t)y * e->width, e->width, u1);
     float dy = e->marginal[y + 1u] - e->marginal[y], dx = row[x + 1u] - row[x];
     float fy = dy > 0.0f ? (u2 - e->marginal[y]) / dy : 0.5f, fx = dx > 0.0f ? (u1 - row[x]) / dx : 0.5f;
     float u = ((float)x + sy_rt_clampf(fx, 0.0f, 1.0f)) / (float)e->width;

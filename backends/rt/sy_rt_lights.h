@@ -15,6 +15,10 @@ typedef struct sy_rt_env_dist {
     float *marginal;    /* height + 1 entries: CDF over rows */
     float *conditional; /* height x (width + 1): CDF over the texels of each row */
     float *texel_pdf;   /* width x height: probability of each texel (sums to 1) */
+    /* guide tables (sy_rt_cdf_guide, sy_rt_cdf_find): for each of the n equal steps of [0, 1) of a
+     * CDF of n cells, the last cell whose CDF value is <= the step's start; height entries for the
+     * marginal, height x width for the rows */
+    uint32_t *guide_marginal, *guide_conditional;
     float mean_luminance; /* the texture's luminance averaged over the sphere (solid-angle weights) */
 } sy_rt_env_dist;
 

@@ -8,12 +8,20 @@
  *     v = 1), u at the poles as atan2f gives it (1: the environment's top and bottom rows are read
  *     where they always were; the Whitted demo's upward floor changed 1.2 % with u = 0.5 there), u
  *     and v within [0, 1], and sy_rt_latlong_dir its inverse within 1e-6 (sin(theta) all over the
- *     sphere, the direction 4.5 degrees and more from the poles). */
+ *     sphere, the direction 4.5 degrees and more from the poles);
+ *   - sy_rt_cdf_find through its guide table (sy_rt_cdf_guide) gives the index the plain binary
+ *     search gives (written out here: the last i < n with cdf[i] <= u, then past empty cells) on
+ *     tables of 1 to 4097 cells, uniform, random, with runs of empty cells (leading, inside,
+ *     trailing), a spike holding nearly all the mass (a sun), and a last entry rounded above 1, for
+ *     random u, every table value and its float neighbours, every step start k / n and its
+ *     neighbours, 0, the largest float below 1, and NaN. */
 #include "../support/sy_check.h"
 #include "sy_rt_math.h"
 
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #ifndef M_PI
@@ -110,4 +118,84 @@ static int test_latlong(void)
     return 0;
 }
 
-SY_CHECK_MAIN("rt_math", SY_TEST(test_atan2), SY_TEST(test_acos), SY_TEST(test_latlong))
+/* the binary search sy_rt_cdf_find replaces, as the environment's sampling had it */
+static uint32_t cdf_find_plain(const float *cdf, uint32_t n, float u)
+{
+    uint32_t lo = 0, hi = n;
+    while (lo + 1u < hi) {
+        uint32_t mid = (lo + hi) / 2u;
+        if (cdf[mid] <= u) lo = mid;
+        else hi = mid;
+    }
+    while (lo + 1u < n && !(cdf[lo + 1u] > cdf[lo])) ++lo;
+    return lo;
+}
+
+static uint32_t lcg(uint32_t *s)
+{
+    *s = *s * 1664525u + 1013904223u;
+    return *s >> 8;
+}
+
+static int test_cdf_find(void)
+{
+    static const uint32_t sizes[] = {1, 2, 3, 7, 64, 1000, 4097};
+    enum { KINDS = 6 };
+    uint32_t seed = 12345u;
+    int bad = 0, checks = 0;
+    for (size_t si = 0; si < sizeof sizes / sizeof sizes[0]; ++si)
+        for (int kind = 0; kind < KINDS; ++kind) {
+            uint32_t n = sizes[si];
+            float *cdf = malloc((n + 1u) * sizeof *cdf);
+            uint32_t *g = malloc(n * sizeof *g);
+            double *wt = malloc(n * sizeof *wt);
+            CHECK(cdf && g && wt);
+            for (uint32_t i = 0; i < n; ++i) {
+                double r = (double)lcg(&seed) / 16777216.0;
+                switch (kind) {
+                case 0: wt[i] = 1.0; break;                                            /* uniform */
+                case 1: wt[i] = r; break;                                              /* random */
+                case 2: wt[i] = i < n / 3u || (i > n / 2u && i < n / 2u + 5u) ? 0.0 : r; break; /* empty runs */
+                case 3: wt[i] = i == n / 2u ? 1e7 : r; break;                          /* a sun */
+                case 4: wt[i] = i + 4u > n ? 0.0 : r + 0.01; break;                   /* trailing empty cells */
+                default: wt[i] = i + 1u == n ? 1e-9 : 1.0; break;                      /* last entry above 1 */
+                }
+            }
+            double tot = 0.0;
+            for (uint32_t i = 0; i < n; ++i) tot += wt[i];
+            if (!(tot > 0.0)) wt[n - 1u] = 1.0, tot = 1.0;
+            double acc = 0.0;
+            cdf[0] = 0.0f;
+            for (uint32_t i = 0; i < n; ++i) acc += wt[i], cdf[i + 1u] = (float)(acc / tot);
+            cdf[n] = 1.0f;
+            if (kind == 5 && n > 1u) cdf[n - 1u] = nextafterf(1.0f, 2.0f); /* rounding past the end */
+            sy_rt_cdf_guide(cdf, n, g);
+            float qs[16];
+            for (uint32_t q = 0; q < 4000u + 6u * n; ++q) {
+                int nq = 0;
+                if (q < 4000u) qs[nq++] = (float)lcg(&seed) / 16777216.0f;
+                else {
+                    uint32_t j = (q - 4000u) / 6u, m = (q - 4000u) % 6u;
+                    float b = m < 3u ? cdf[j] : (float)j / (float)n;
+                    qs[nq++] = b;
+                    qs[nq++] = nextafterf(b, -1.0f);
+                    qs[nq++] = nextafterf(b, 2.0f);
+                }
+                if (q == 0) qs[nq++] = 0.0f, qs[nq++] = nextafterf(1.0f, 0.0f), qs[nq++] = NAN;
+                for (int t = 0; t < nq; ++t) {
+                    if (!(qs[t] < 1.0f) && !isnan(qs[t])) continue; /* u in [0, 1) (and NaN) */
+                    if (qs[t] < 0.0f) continue;
+                    uint32_t want = cdf_find_plain(cdf, n, qs[t]), got = sy_rt_cdf_find(cdf, g, n, qs[t]);
+                    ++checks;
+                    if (want != got && bad++ < 5)
+                        printf("n %u kind %d u %.9g: guided %u, binary search %u\n", n, kind, (double)qs[t], got, want);
+                }
+            }
+            free(cdf), free(g), free(wt);
+        }
+    EXPECT_MSG(bad == 0, "%d of %d look-ups differ from the binary search", bad, checks);
+    EXPECT(checks > 100000);
+    return 0;
+}
+
+SY_CHECK_MAIN("rt_math", SY_TEST(test_atan2), SY_TEST(test_acos), SY_TEST(test_latlong), SY_TEST(test_cdf_find))
