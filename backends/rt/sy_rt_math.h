@@ -1,4 +1,6 @@
-/* sy_rt_math.h — small inline float3 / matrix helpers used inside the ray-tracing back-end.
+/* sy_rt_math.h — small inline float3 / matrix helpers used inside the ray-tracing back-end, with
+ * the per-sample functions built on them: sine and cosine of 2 pi u, atan2 and acos without libm,
+ * the environments' lat-long mapping, CDF searches.
  * Header-only; internal to backends/rt (the public API uses plain float arrays). */
 #ifndef SY_RT_MATH_H
 #define SY_RT_MATH_H
@@ -76,7 +78,7 @@ static inline float sy_rt_acosf(float c)
     float r = sqrtf(1.0f - a) * p; /* a > 1: NaN, as acosf */
     return c < 0.0f ? 3.14159265f - r : r;
 }
-/* atan2(y, x): the same quadrants and signed zeros as atan2f */
+/* atan2(y, x) of finite x, y: the same quadrants and signed zeros as atan2f */
 static inline float sy_rt_atan2f(float y, float x)
 {
     float ax = fabsf(x), ay = fabsf(y);
@@ -101,10 +103,9 @@ static inline sy_rt_v3 sy_rt_latlong_dir(float u, float v, float *st)
     return v3(s * sinf(phi), cosf(theta), -s * cosf(phi));
 }
 /* The last i < n with cdf[i] <= x in a non-decreasing table (0 when there is none; NaN x: 0), by
- * binary search with a select per step, not a branch: the inversions of the environment's
- * distribution and of Whitted's emitters. (In sy_rt_env_sample, 12 % of a Whitted render of the
- * demo, the time is the searches' loads, each waiting on the one before: a branch per step was as
- * fast.) */
+ * binary search with a select per step: Whitted's emitters' inversion, and the environment's
+ * within the cells its guide table leaves (sy_rt_cdf_find). (A search's time is its loads, each
+ * waiting on the one before: a branch per step was as fast.) */
 static inline uint32_t sy_rt_cdf_last_le(const float *cdf, uint32_t n, float x)
 {
     uint32_t i = 0;
