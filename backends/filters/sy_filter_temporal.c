@@ -124,8 +124,6 @@ struct sy_filter_temporal {
      * fourth plane), for sy_filter_temporal_rest */
     float *est;
     size_t est_cap;
-    float *dummy; /* 2 rows of dummy_cap: class -1, then zeros (a-trous rows outside the image) */
-    size_t dummy_cap;
     uint32_t est_w, est_h;
     bool have_est;
 };
@@ -261,7 +259,7 @@ void sy_filter_temporal_destroy(sy_filter_temporal *t)
     if (!t) return;
     hist_free(&t->h[0]), hist_free(&t->h[1]);
     work_free(t);
-    free(t->est), free(t->dummy);
+    free(t->est);
     free(t);
 }
 
@@ -767,53 +765,56 @@ static void atrous_end(int w, const float *restrict h, const float *restrict c0,
 }
 
 /* The 8 neighbours of an a-trous pass at step s around column x, each through the caller's SY_TAP
- * (row u, m or d above, at or below; column; B3-spline weight kd or ke; depth scale for the diagonal) */
+ * (the offset from the pixel's index to its tap's: -sw above, 0 on the row, +sw below, -s, 0, +s
+ * across; B3-spline weight kd or ke; depth scale for the diagonal) */
 #define SY_ATROUS_TAPS8()                                                                                             \
     do {                                                                                                              \
-        SY_TAP(u, x - s, kd, dg);                                                                                     \
-        SY_TAP(u, x, ke, 1.0f);                                                                                       \
-        SY_TAP(u, x + s, kd, dg);                                                                                     \
-        SY_TAP(m, x - s, ke, 1.0f);                                                                                   \
-        SY_TAP(m, x + s, ke, 1.0f);                                                                                   \
-        SY_TAP(d, x - s, kd, dg);                                                                                     \
-        SY_TAP(d, x, ke, 1.0f);                                                                                       \
-        SY_TAP(d, x + s, kd, dg);                                                                                     \
+        SY_TAP(x - sw - s, kd, dg);                                                                                   \
+        SY_TAP(x - sw, ke, 1.0f);                                                                                     \
+        SY_TAP(x - sw + s, kd, dg);                                                                                   \
+        SY_TAP(x - s, ke, 1.0f);                                                                                      \
+        SY_TAP(x + s, ke, 1.0f);                                                                                      \
+        SY_TAP(x + sw - s, kd, dg);                                                                                   \
+        SY_TAP(x + sw, ke, 1.0f);                                                                                     \
+        SY_TAP(x + sw + s, kd, dg);                                                                                   \
     } while (0)
 
-/* a-trous, the 8 taps of the pixels [x0, x1) of a row at once (every tap column in the image):
- * rows u (y - s), m (y), d (y + s) of class, depth, normal, colour and variance (a row outside the
- * image: class -1, which no centre matches, and zeros), the centre's normal, luminance and depth
+/* a-trous, the 8 taps of the pixels [x0, x1) of row y at once (every tap in the image: rows y - s
+ * and y + s too): class, depth, normal, colour and variance planes (each from row y's start: rows
+ * y -+ s are sw = s x width floats before and after), the centre's normal, luminance and depth
  * stops; the taps in the order of atrous_tap's calls, the sums in registers, then atrous_end's
- * result (o colour, ov variance; the source where the centre is no hit) */
-#define SY_ROW3(T, name) const T *restrict name##u, const T *restrict name##m, const T *restrict name##d
+ * result (o colour, ov variance; the source where the centre is no hit). One pointer per plane and
+ * the taps' offsets from it (a pointer per plane and row took 39, and a row of class -1 for rows
+ * outside the image, which now go tap by tap): the same results, about as fast (docs/FILTERS.md). */
 SY_TEMPORAL_CLONES
-static void atrous_row8(int x0, int x1, int s, SY_ROW3(float, cl), SY_ROW3(float, z), SY_ROW3(float, na),
-                        SY_ROW3(float, nb), SY_ROW3(float, nc), SY_ROW3(float, ca), SY_ROW3(float, cb),
-                        SY_ROW3(float, cc), SY_ROW3(float, v), const float *restrict sn, const float *restrict il,
+static void atrous_row8(int x0, int x1, int s, ptrdiff_t sw, const float *restrict cl, const float *restrict z,
+                        const float *restrict na, const float *restrict nb, const float *restrict nc,
+                        const float *restrict ca, const float *restrict cb, const float *restrict cc,
+                        const float *restrict v, const float *restrict sn, const float *restrict il,
                         const float *restrict iz, float *restrict o0, float *restrict o1, float *restrict o2,
                         float *restrict ov, float xmax)
 {
     const float kc = 0.25f, ke = 0.125f, kd = 0.0625f, dg = 0.70710678f;
-    for (int x = x0; x < x1; ++x) {
-        float ci = clm[x], li = lum3(cam[x], cbm[x], ccm[x]), zi = zm[x], n0 = nam[x], n1 = nbm[x], n2 = ncm[x];
+    for (ptrdiff_t x = x0; x < x1; ++x) {
+        float ci = cl[x], li = lum3(ca[x], cb[x], cc[x]), zi = z[x], n0 = na[x], n1 = nb[x], n2 = nc[x];
         float si = sn[x], ii = il[x], iz_ = iz[x];
-        float a0 = kc * cam[x], a1 = kc * cbm[x], a2 = kc * ccm[x], W = kc, V = kc * kc * vm[x];
-#define SY_TAP(R, J, KK, ZD)                                                                                          \
+        float a0 = kc * ca[x], a1 = kc * cb[x], a2 = kc * cc[x], W = kc, V = kc * kc * v[x];
+#define SY_TAP(J, KK, ZD)                                                                                             \
     do {                                                                                                              \
-        int j_ = (J);                                                                                                 \
-        float dn = 1.0f - (n0 * na##R[j_] + n1 * nb##R[j_] + n2 * nc##R[j_]);                                         \
-        float lj = lum3(ca##R[j_], cb##R[j_], cc##R[j_]);                                                             \
-        float arg = fabsf(li - lj) * ii + fabsf(zi - z##R[j_]) * iz_ * (ZD) + si * fmx(dn, 0.0f);                     \
-        float k = (KK) * expneg(arg, xmax) * (float)(cl##R[j_] == ci);                                                \
-        a0 += k * ca##R[j_], a1 += k * cb##R[j_], a2 += k * cc##R[j_];                                                \
-        W += k, V += k * k * v##R[j_];                                                                                \
+        ptrdiff_t j_ = (J);                                                                                           \
+        float dn = 1.0f - (n0 * na[j_] + n1 * nb[j_] + n2 * nc[j_]);                                                  \
+        float lj = lum3(ca[j_], cb[j_], cc[j_]);                                                                      \
+        float arg = fabsf(li - lj) * ii + fabsf(zi - z[j_]) * iz_ * (ZD) + si * fmx(dn, 0.0f);                        \
+        float k = (KK) * expneg(arg, xmax) * (float)(cl[j_] == ci);                                                   \
+        a0 += k * ca[j_], a1 += k * cb[j_], a2 += k * cc[j_];                                                         \
+        W += k, V += k * k * v[j_];                                                                                   \
     } while (0)
         SY_ATROUS_TAPS8();
 #undef SY_TAP
         float h = (float)(ci > 0.0f), k = 1.0f - h, iw = 1.0f / W;
-        float r0 = h * (a0 * iw) + k * cam[x], r1 = h * (a1 * iw) + k * cbm[x], r2 = h * (a2 * iw) + k * ccm[x];
+        float r0 = h * (a0 * iw) + k * ca[x], r1 = h * (a1 * iw) + k * cb[x], r2 = h * (a2 * iw) + k * cc[x];
         o0[x] = r0, o1[x] = r1, o2[x] = r2;
-        ov[x] = h * (V * iw * iw) + k * vm[x];
+        ov[x] = h * (V * iw * iw) + k * v[x];
     }
 }
 
@@ -821,45 +822,45 @@ static void atrous_row8(int x0, int x1, int s, SY_ROW3(float, cl), SY_ROW3(float
  * the class, depth and normal terms are computed once for both, each part's sums as atrous_row8's
  * (the same operations in the same order: the same results as two calls) */
 SY_TEMPORAL_CLONES
-static void atrous_row8_2(int x0, int x1, int s, SY_ROW3(float, cl), SY_ROW3(float, z), SY_ROW3(float, na),
-                          SY_ROW3(float, nb), SY_ROW3(float, nc), const float *restrict sn, const float *restrict iz,
-                          SY_ROW3(float, ca), SY_ROW3(float, cb), SY_ROW3(float, cc), SY_ROW3(float, v),
+static void atrous_row8_2(int x0, int x1, int s, ptrdiff_t sw, const float *restrict cl, const float *restrict z,
+                          const float *restrict na, const float *restrict nb, const float *restrict nc,
+                          const float *restrict sn, const float *restrict iz, const float *restrict ca,
+                          const float *restrict cb, const float *restrict cc, const float *restrict v,
                           const float *restrict il, float *restrict o0, float *restrict o1, float *restrict o2,
-                          float *restrict ov, SY_ROW3(float, ca2), SY_ROW3(float, cb2), SY_ROW3(float, cc2),
-                          SY_ROW3(float, v2), const float *restrict il2, float *restrict p0, float *restrict p1,
-                          float *restrict p2, float *restrict pv, float xmax)
+                          float *restrict ov, const float *restrict ca2, const float *restrict cb2,
+                          const float *restrict cc2, const float *restrict v2, const float *restrict il2,
+                          float *restrict p0, float *restrict p1, float *restrict p2, float *restrict pv, float xmax)
 {
     const float kc = 0.25f, ke = 0.125f, kd = 0.0625f, dg = 0.70710678f;
-    for (int x = x0; x < x1; ++x) {
-        float ci = clm[x], zi = zm[x], n0 = nam[x], n1 = nbm[x], n2 = ncm[x], si = sn[x], iz_ = iz[x];
-        float li = lum3(cam[x], cbm[x], ccm[x]), ii = il[x], li2 = lum3(ca2m[x], cb2m[x], cc2m[x]), ii2 = il2[x];
-        float a0 = kc * cam[x], a1 = kc * cbm[x], a2 = kc * ccm[x], W = kc, V = kc * kc * vm[x];
-        float b0 = kc * ca2m[x], b1 = kc * cb2m[x], b2 = kc * cc2m[x], W2 = kc, V2 = kc * kc * v2m[x];
-#define SY_TAP(R, J, KK, ZD)                                                                                          \
+    for (ptrdiff_t x = x0; x < x1; ++x) {
+        float ci = cl[x], zi = z[x], n0 = na[x], n1 = nb[x], n2 = nc[x], si = sn[x], iz_ = iz[x];
+        float li = lum3(ca[x], cb[x], cc[x]), ii = il[x], li2 = lum3(ca2[x], cb2[x], cc2[x]), ii2 = il2[x];
+        float a0 = kc * ca[x], a1 = kc * cb[x], a2 = kc * cc[x], W = kc, V = kc * kc * v[x];
+        float b0 = kc * ca2[x], b1 = kc * cb2[x], b2 = kc * cc2[x], W2 = kc, V2 = kc * kc * v2[x];
+#define SY_TAP(J, KK, ZD)                                                                                             \
     do {                                                                                                              \
-        int j_ = (J);                                                                                                 \
-        float dn = 1.0f - (n0 * na##R[j_] + n1 * nb##R[j_] + n2 * nc##R[j_]);                                         \
-        float gz = fabsf(zi - z##R[j_]) * iz_ * (ZD), gn = si * fmx(dn, 0.0f), m = (float)(cl##R[j_] == ci);         \
-        float lj = lum3(ca##R[j_], cb##R[j_], cc##R[j_]), lj2 = lum3(ca2##R[j_], cb2##R[j_], cc2##R[j_]);             \
+        ptrdiff_t j_ = (J);                                                                                           \
+        float dn = 1.0f - (n0 * na[j_] + n1 * nb[j_] + n2 * nc[j_]);                                                  \
+        float gz = fabsf(zi - z[j_]) * iz_ * (ZD), gn = si * fmx(dn, 0.0f), m = (float)(cl[j_] == ci);                \
+        float lj = lum3(ca[j_], cb[j_], cc[j_]), lj2 = lum3(ca2[j_], cb2[j_], cc2[j_]);                               \
         float arg = fabsf(li - lj) * ii + gz + gn, arg2 = fabsf(li2 - lj2) * ii2 + gz + gn;                           \
         float k = (KK) * expneg(arg, xmax) * m, k2 = (KK) * expneg(arg2, xmax) * m;                                  \
-        a0 += k * ca##R[j_], a1 += k * cb##R[j_], a2 += k * cc##R[j_];                                                \
-        W += k, V += k * k * v##R[j_];                                                                                \
-        b0 += k2 * ca2##R[j_], b1 += k2 * cb2##R[j_], b2 += k2 * cc2##R[j_];                                          \
-        W2 += k2, V2 += k2 * k2 * v2##R[j_];                                                                          \
+        a0 += k * ca[j_], a1 += k * cb[j_], a2 += k * cc[j_];                                                         \
+        W += k, V += k * k * v[j_];                                                                                   \
+        b0 += k2 * ca2[j_], b1 += k2 * cb2[j_], b2 += k2 * cc2[j_];                                                   \
+        W2 += k2, V2 += k2 * k2 * v2[j_];                                                                             \
     } while (0)
         SY_ATROUS_TAPS8();
 #undef SY_TAP
         float h = (float)(ci > 0.0f), k = 1.0f - h, iw = 1.0f / W, iw2 = 1.0f / W2;
-        float r0 = h * (a0 * iw) + k * cam[x], r1 = h * (a1 * iw) + k * cbm[x], r2 = h * (a2 * iw) + k * ccm[x];
+        float r0 = h * (a0 * iw) + k * ca[x], r1 = h * (a1 * iw) + k * cb[x], r2 = h * (a2 * iw) + k * cc[x];
         o0[x] = r0, o1[x] = r1, o2[x] = r2;
-        ov[x] = h * (V * iw * iw) + k * vm[x];
-        float q0 = h * (b0 * iw2) + k * ca2m[x], q1 = h * (b1 * iw2) + k * cb2m[x], q2 = h * (b2 * iw2) + k * cc2m[x];
+        ov[x] = h * (V * iw * iw) + k * v[x];
+        float q0 = h * (b0 * iw2) + k * ca2[x], q1 = h * (b1 * iw2) + k * cb2[x], q2 = h * (b2 * iw2) + k * cc2[x];
         p0[x] = q0, p1[x] = q1, p2[x] = q2;
-        pv[x] = h * (V2 * iw2 * iw2) + k * v2m[x];
+        pv[x] = h * (V2 * iw2 * iw2) + k * v2[x];
     }
 }
-#undef SY_ROW3
 
 /* one a-trous pass (3x3 B-spline, taps c->step apart) over hits, tap by tap over each row;
  * neighbours only of the centre's class (hit with a normal, hit without one); a pixel without a hit
@@ -877,27 +878,22 @@ static void atrous_rows(void *vc, uint32_t y0, uint32_t y1)
     const float *PC[2] = {c->src, c->src2}, *PV[2] = {c->vsrc, c->vsrc2};
     const float *PIL[2] = {plane(c, W_IL), plane(c, W_IL2)};
     float *PD[2] = {c->dst, c->dst2}, *PDV[2] = {c->vdst, c->vdst2};
-    const float *neg = c->t->dummy, *zero = c->t->dummy + w; /* a row outside the image */
     float *WS = plane(c, W_WS);
     const float k0 = hk[1] * hk[1]; /* the centre: exactly its kernel weight */
     /* the columns whose taps all lie in the image run fused (atrous_row8); the s columns at either
-     * edge tap by tap */
-    int xa = s < w ? s : w, xb = w - s > xa ? w - s : xa;
+     * edge, and the rows whose neighbour rows y -+ s are not both in the image, tap by tap */
+    int xa0 = s < w ? s : w, xb0 = w - s > xa0 ? w - s : xa0;
+    ptrdiff_t sw = (ptrdiff_t)s * w;
     for (int y = (int)y0; y < (int)y1; ++y) {
         size_t row = (size_t)y * w;
+        bool rows_in = y - s >= 0 && y + s < hgt;
+        int xa = rows_in ? xa0 : w, xb = rows_in ? xb0 : w;
         vblur_row(c, y);
         if (xb > xa) {
-            /* class, depth, normal 3; per part colour 3, variance: rows u, m, d */
-            const float *P[13][3];
-            for (int r = 0; r < 3; ++r) {
-                int yy = y + (r - 1) * s;
-                bool in = yy >= 0 && yy < hgt;
-                size_t o = in ? (size_t)yy * w : 0;
-                const float *src[13] = {cls,   Z,     N0,        N1,            N2,   /* the guides */
-                                        PC[0], PC[0] + n, PC[0] + 2 * n, PV[0], /* part 0 */
-                                        PC[1], PC[1] + n, PC[1] + 2 * n, PV[1]}; /* part 1 */
-                for (int q = 0; q < 5 + 4 * parts; ++q) P[q][r] = in ? src[q] + o : (q == 0 ? neg : zero);
-            }
+            /* class, depth, normal 3; per part colour 3, variance: from row y */
+            const float *P[13] = {cls + row, Z + row, N0 + row, N1 + row, N2 + row}; /* the guides */
+            for (int k = 0; k < parts; ++k)
+                for (int q = 0; q < 4; ++q) P[5 + 4 * k + q] = (q < 3 ? PC[k] + q * n : PV[k]) + row;
             float *o0 = PD[0] + row, *o1 = PD[0] + n + row, *o2 = PD[0] + 2 * n + row, *ov = PDV[0] + row;
             /* what a chunk reads at its own columns (the centre's planes and the outputs), and at
              * its columns shifted by -s, 0, +s (the 5 + 4 x parts neighbour planes' 3 rows) */
@@ -906,22 +902,19 @@ static void atrous_rows(void *vc, uint32_t y0, uint32_t y1)
             const float *PN[39];
             int nm = parts == 2 ? 12 : 7, nn = 0;
             for (int q = 0; q < 5 + 4 * parts; ++q)
-                for (int r = 0; r < 3; ++r) PN[nn++] = P[q][r];
+                for (int r = -1; r <= 1; ++r) PN[nn++] = P[q] + r * sw;
             for (int xc = xa; xc < xb; xc += PF_COLS) {
                 int xe = xb - xc > PF_COLS ? xc + PF_COLS : xb, xn = xb - xe > PF_COLS ? xe + PF_COLS : xb;
                 prefetch_cols(PM, nm, 0, xe, xn);
                 prefetch_cols(PN, nn, -s, xe, xn);
                 prefetch_cols(PN, nn, s, xe, xn);
-#define SY_R3(q) P[q][0], P[q][1], P[q][2]
                 if (parts == 2)
-                    atrous_row8_2(xc, xe, s, SY_R3(0), SY_R3(1), SY_R3(2), SY_R3(3), SY_R3(4), SN + row, IZ + row,
-                                  SY_R3(5), SY_R3(6), SY_R3(7), SY_R3(8), PIL[0] + row, o0, o1, o2, ov, SY_R3(9),
-                                  SY_R3(10), SY_R3(11), SY_R3(12), PIL[1] + row, PD[1] + row, PD[1] + n + row,
-                                  PD[1] + 2 * n + row, PDV[1] + row, c->xmax);
+                    atrous_row8_2(xc, xe, s, sw, P[0], P[1], P[2], P[3], P[4], SN + row, IZ + row, P[5], P[6], P[7],
+                                  P[8], PIL[0] + row, o0, o1, o2, ov, P[9], P[10], P[11], P[12], PIL[1] + row,
+                                  PD[1] + row, PD[1] + n + row, PD[1] + 2 * n + row, PDV[1] + row, c->xmax);
                 else
-                    atrous_row8(xc, xe, s, SY_R3(0), SY_R3(1), SY_R3(2), SY_R3(3), SY_R3(4), SY_R3(5), SY_R3(6),
-                                SY_R3(7), SY_R3(8), SN + row, PIL[0] + row, IZ + row, o0, o1, o2, ov, c->xmax);
-#undef SY_R3
+                    atrous_row8(xc, xe, s, sw, P[0], P[1], P[2], P[3], P[4], P[5], P[6], P[7], P[8], SN + row,
+                                PIL[0] + row, IZ + row, o0, o1, o2, ov, c->xmax);
             }
         }
         for (int k = 0; k < parts; ++k) {
@@ -1023,13 +1016,7 @@ sy_filter_status sy_filter_temporal_run(sy_filter_temporal *t, const sy_filter_f
         t->est = np <= SIZE_MAX / (4 * sizeof(float)) ? planes_alloc(4 * np * sizeof(float)) : NULL;
         t->est_cap = t->est ? np : 0;
     }
-    if (in->width > t->dummy_cap) {
-        free(t->dummy);
-        t->dummy = malloc(2 * (size_t)in->width * sizeof(float));
-        t->dummy_cap = t->dummy ? in->width : 0;
-        for (size_t x = 0; x < t->dummy_cap; ++x) t->dummy[x] = -1.0f, t->dummy[t->dummy_cap + x] = 0.0f;
-    }
-    if (!t->est || !t->dummy || !work_reserve(t, n) || !hist_reserve(nx, n)) {
+    if (!t->est || !work_reserve(t, n) || !hist_reserve(nx, n)) {
         t->have_prev = false;
         return sy_filter_fail(err, SY_FILTER_ERROR_OUT_OF_MEMORY, "temporal: out of memory for %ux%u", in->width,
                               in->height);
