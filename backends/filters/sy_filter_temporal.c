@@ -42,29 +42,6 @@
 #include <sys/mman.h>
 #endif
 
-/* exp(-x) for x >= 0 (NaN counts as large): sy_filter_expneg's polynomial without its branch, so
- * that it vectorises; x is clamped to xmax (callers pass EXP_MAX). xmax reaches the row loop through
- * memory, not as a constant: with a constant, GCC folds the clamped case into a branch of its own and
- * then cannot vectorise the AVX2 clone.
- * EXP_MAX is 16: a clamped tap's weight, at most 0.125 e^-16 = 1.4e-8, is below half an ulp of any
- * sum of weights (the centre alone is 0.25), so it changes none, and it and its square (the
- * variance's weight) stay normal floats. Clamped at 87 (as before), far taps' weights and their
- * squares were subnormal, which this machine computes slowly: the a-trous phase about 0.8x with 16
- * on the demo (docs/FILTERS.md, "Subnormal weights"). */
-#define EXP_MAX 16.0f
-static inline SY_TEMPORAL_INLINE float expneg(float x, float xmax)
-{
-    x = fmn(x, xmax);
-    float y = x * 1.44269504f;
-    int32_t k = (int32_t)y;
-    float f = y - (float)k;
-    float p = 1.0f + f * (-0.69314718f + f * (0.24022651f + f * (-0.05550411f + f * (0.00961813f - f * 0.00133336f))));
-    int32_t bits = (127 - k) * (1 << 23);
-    float s;
-    memcpy(&s, &bits, sizeof s);
-    return p * s;
-}
-
 /* One frame's history: what the next frame reprojects. Planes of w*h floats, plane q of a group at
  * base + q*stride (plane_stride). */
 typedef struct hist {

@@ -7,10 +7,13 @@
  * several times over a noisy pan; with the direct/indirect split an emitter stays sharp while the
  * noise is filtered; object motion vectors keep a sliding object's history on the object; the
  * passes' column blocks leave no trace (a mirror-symmetric frame stays symmetric); NaN pixels stay
- * isolated; bad parameters and frames are refused. */
+ * isolated; bad parameters and frames are refused; the a-trous edge-stopping weight stays within
+ * its documented bounds of exp. */
 #include "sy_filter_temporal.h"
+#include "sy_filter_temporal_internal.h"
 #include "synth.h"
 
+#include <math.h>
 #include <string.h>
 
 #define YFOV 1.0471976f /* 60 degrees */
@@ -572,6 +575,35 @@ static int test_block_symmetry(void)
     return 0;
 }
 
+/* the a-trous edge-stopping weight (expneg, sy_filter_temporal_internal.h): 1 at 0, within -0.0003 %
+ * and +6.2 % of exp(-x) over [0, EXP_MAX], exact at multiples of ln 2, never rising, NaN and large x
+ * clamped to EXP_MAX, whose weight is a normal float below half an ulp of the centre's 0.25 */
+static int test_weight(void)
+{
+    CHECK(expneg(0.0f, EXP_MAX) == 1.0f);
+    double lo = 2.0, hi = 0.0;
+    float prev = 2.0f;
+    for (int i = 0; i <= 1600000; ++i) {
+        float x = (float)i * 1e-5f, e = expneg(x, EXP_MAX);
+        double r = e / exp(-(double)x);
+        lo = r < lo ? r : lo, hi = r > hi ? r : hi;
+        CHECK(e <= prev);
+        prev = e;
+    }
+    CHECK(lo > 1.0 - 3e-6 && lo <= 1.0);
+    CHECK(hi > 1.06 && hi < 1.062);
+    for (int k = 1; k <= 16; ++k) { /* x = k ln 2: 2^-k up to the float rounding of x */
+        float e = expneg((float)k * 0.69314718f, EXP_MAX);
+        CHECK(fabs(e * ldexp(1.0, k) - 1.0) < 1e-5);
+    }
+    float top = expneg(EXP_MAX, EXP_MAX);
+    CHECK(expneg(NAN, EXP_MAX) == top && expneg(1e30f, EXP_MAX) == top && expneg(INFINITY, EXP_MAX) == top);
+    CHECK(isnormal(top) && isnormal(0.125f * top * 0.125f * top));
+    volatile float centre = 0.25f;
+    CHECK(centre + 0.125f * top == centre);
+    return 0;
+}
+
 int main(void)
 {
     RUN(test_constant_pan);
@@ -583,5 +615,6 @@ int main(void)
     RUN(test_object_motion);
     RUN(test_block_symmetry);
     RUN(test_bad_input);
+    RUN(test_weight);
     return sy_check_finish("filters temporal");
 }
