@@ -839,6 +839,17 @@ static void atrous_row8_2(int x0, int x1, int s, ptrdiff_t sw, const float *rest
     }
 }
 
+/* Whether any of the columns [x0, x1) of a class row is a hit. The a-trous rows skip the groups of
+ * MISS_GROUP columns without one (sky, background): a pixel without a hit keeps its source, so the
+ * fused loop's taps there change nothing. */
+enum { MISS_GROUP = 16 };
+static inline bool any_hit(const float *restrict cls, int x0, int x1)
+{
+    int any = 0;
+    for (int x = x0; x < x1; ++x) any |= cls[x] > 0.0f;
+    return any != 0;
+}
+
 /* one a-trous pass (3x3 B-spline, taps c->step apart) over hits, tap by tap over each row;
  * neighbours only of the centre's class (hit with a normal, hit without one); a pixel without a hit
  * keeps its value. With c->two, the direct part (src2 -> dst2) in the same pass. */
@@ -880,19 +891,38 @@ static void atrous_rows(void *vc, uint32_t y0, uint32_t y1)
             int nm = parts == 2 ? 12 : 7, nn = 0;
             for (int q = 0; q < 5 + 4 * parts; ++q)
                 for (int r = -1; r <= 1; ++r) PN[nn++] = P[q] + r * sw;
+#define SY_FUSED(A, B)                                                                                                \
+    do {                                                                                                              \
+        if (parts == 2)                                                                                               \
+            atrous_row8_2((A), (B), s, sw, P[0], P[1], P[2], P[3], P[4], SN + row, IZ + row, P[5], P[6], P[7], P[8],  \
+                          PIL[0] + row, o0, o1, o2, ov, P[9], P[10], P[11], P[12], PIL[1] + row, PD[1] + row,         \
+                          PD[1] + n + row, PD[1] + 2 * n + row, PDV[1] + row, c->xmax);                               \
+        else                                                                                                          \
+            atrous_row8((A), (B), s, sw, P[0], P[1], P[2], P[3], P[4], P[5], P[6], P[7], P[8], SN + row,              \
+                        PIL[0] + row, IZ + row, o0, o1, o2, ov, c->xmax);                                             \
+    } while (0)
             for (int xc = xa; xc < xb; xc += PF_COLS) {
                 int xe = xb - xc > PF_COLS ? xc + PF_COLS : xb, xn = xb - xe > PF_COLS ? xe + PF_COLS : xb;
                 prefetch_cols(PM, nm, 0, xe, xn);
                 prefetch_cols(PN, nn, -s, xe, xn);
                 prefetch_cols(PN, nn, s, xe, xn);
-                if (parts == 2)
-                    atrous_row8_2(xc, xe, s, sw, P[0], P[1], P[2], P[3], P[4], SN + row, IZ + row, P[5], P[6], P[7],
-                                  P[8], PIL[0] + row, o0, o1, o2, ov, P[9], P[10], P[11], P[12], PIL[1] + row,
-                                  PD[1] + row, PD[1] + n + row, PD[1] + 2 * n + row, PDV[1] + row, c->xmax);
-                else
-                    atrous_row8(xc, xe, s, sw, P[0], P[1], P[2], P[3], P[4], P[5], P[6], P[7], P[8], SN + row,
-                                PIL[0] + row, IZ + row, o0, o1, o2, ov, c->xmax);
+                /* groups of MISS_GROUP columns without a hit keep their source (what the fused loop
+                 * gives them, without its taps); the runs of groups with one go through the loop */
+                int xr = xc;
+                for (int g = xc; g < xe; g += MISS_GROUP) {
+                    int ge = xe - g > MISS_GROUP ? g + MISS_GROUP : xe;
+                    if (any_hit(P[0], g, ge)) continue;
+                    if (g > xr) SY_FUSED(xr, g);
+                    for (int k = 0; k < parts; ++k) {
+                        size_t b = (size_t)(ge - g) * sizeof(float);
+                        for (int q = 0; q < 3; ++q) memcpy(PD[k] + q * n + row + g, PC[k] + q * n + row + g, b);
+                        memcpy(PDV[k] + row + g, PV[k] + row + g, b);
+                    }
+                    xr = ge;
+                }
+                if (xe > xr) SY_FUSED(xr, xe);
             }
+#undef SY_FUSED
         }
         for (int k = 0; k < parts; ++k) {
             const float *C0 = PC[k], *C1 = PC[k] + n, *C2 = PC[k] + 2 * n, *V = PV[k], *IL = PIL[k];

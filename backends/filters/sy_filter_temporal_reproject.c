@@ -125,6 +125,13 @@ __attribute__((target("avx2"))) static void reproject_row_avx2(
         vm = _mm256_and_ps(vm, _mm256_and_ps(_mm256_cmp_ps(fx, m1, _CMP_GT_OQ), _mm256_cmp_ps(fy, m1, _CMP_GT_OQ)));
         vm = _mm256_and_ps(vm, _mm256_and_ps(_mm256_cmp_ps(fx, fw, _CMP_LT_OQ), _mm256_cmp_ps(fy, fh, _CMP_LT_OQ)));
         __m256 valid = _mm256_and_ps(vm, _mm256_loadu_ps(h + x)); /* h (1) where valid, else 0 */
+        /* no lane can find history (misses, points outside the previous view): the taps' result,
+         * zeros (every weight is 0 and the history is finite), without their 68 gathers */
+        if (_mm256_movemask_ps(vm) == 0) {
+            for (int q = 0; q < 11; ++q) _mm256_storeu_ps(R + (size_t)q * n + x, zero);
+            _mm256_storeu_ps(ru + x, zero);
+            continue;
+        }
         fx = _mm256_max_ps(m1, _mm256_min_ps(fx, fw)), fy = _mm256_max_ps(m1, _mm256_min_ps(fy, fh));
         __m256i x0 = _mm256_sub_epi32(_mm256_cvttps_epi32(_mm256_add_ps(fx, one)), ione);
         __m256i y0 = _mm256_sub_epi32(_mm256_cvttps_epi32(_mm256_add_ps(fy, one)), ione);
