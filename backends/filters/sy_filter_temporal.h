@@ -32,9 +32,9 @@
  *   4. a-trous: atrous_iterations passes of a 3x3 B-spline kernel with taps 2^k apart, weights
  *      exp(-|l_i - l_j| / (sigma_luminance sqrt(blurred variance_i)) - |z_i - z_j| / (sigma_depth
  *      step |grad z_i|) - sigma_normal (1 - n_i.n_j)) (exp(-x) as 2^(-x log2 e) linear between
- *      integer powers of 2: within -0.0003 % and +6.2 % of exp, monotone, exact at x = 0), the variance
- *      filtered with the squared weights; the output of the first pass becomes the next frame's history (as SVGF; not for
- *      the direct part, below).
+ *      integer powers of 2: within -0.0003 % and +6.2 % of exp, monotone, exact at x = 0), the
+ *      variance filtered with the squared weights; the output of the first pass becomes the next
+ *      frame's history (as SVGF; not for the direct part, below).
  * The result is remodulated by the albedo. NaN/Inf inputs are neither read by neighbours nor kept
  * in the history (the pixel shows its own colour, or 0).
  *
