@@ -485,31 +485,87 @@ static void count_tap(int x0, int x1, float axial, const float *restrict h, cons
     }
 }
 
+/* stats_tap's eight terms of one part at columns [0, n) of a row, each once (t: 8 rows of IB + 2
+ * floats: m v0, m v1, m v2, m v0^2, m v1^2, m v2^2, m l, m l^2), for stats_sum9 */
+SY_TEMPORAL_CLONES
+static void stats_terms(int n, const float *restrict h, const float *restrict a0, const float *restrict a1,
+                        const float *restrict a2, const float *restrict l0, float *restrict t)
+{
+    enum { TS = IB + 2 };
+    float *restrict t0 = t, *restrict t1 = t + TS, *restrict t2 = t + 2 * TS, *restrict t3 = t + 3 * TS;
+    float *restrict t4 = t + 4 * TS, *restrict t5 = t + 5 * TS, *restrict t6 = t + 6 * TS, *restrict t7 = t + 7 * TS;
+    for (int x = 0; x < n; ++x) {
+        float m = h[x];
+        float v0 = 0.25f * a0[x] + 0.5f * a1[x] + 0.25f * a2[x], v1 = 0.5f * a0[x] - 0.5f * a2[x],
+              v2 = -0.25f * a0[x] + 0.5f * a1[x] - 0.25f * a2[x];
+        float l = l0[x];
+        t0[x] = m * v0, t1[x] = m * v1, t2[x] = m * v2;
+        t3[x] = m * (v0 * v0), t4[x] = m * (v1 * v1), t5[x] = m * (v2 * v2);
+        t6[x] = m * l, t7[x] = m * (l * l);
+    }
+}
+
+/* one statistic's 3x3 sums at columns [0, n) from its terms on rows y - 1 (a), y (b), y + 1 (c),
+ * column x's neighbours at x, x + 1, x + 2: stats_tap's sum, the same additions in the same order
+ * (from 0, the taps dy then dx from -1) */
+SY_TEMPORAL_CLONES
+static void stats_sum9(int n, const float *restrict a, const float *restrict b, const float *restrict c,
+                       float *restrict s)
+{
+    for (int x = 0; x < n; ++x)
+        s[x] = 0.0f + a[x] + a[x + 1] + a[x + 2] + b[x] + b[x + 1] + b[x + 2] + c[x] + c[x + 1] + c[x + 2];
+}
+
 /* the 3x3 statistics of the hits' new samples at columns [xc, xc + bw) of row y (S: S_COUNT planes
  * of IB floats, column xc at 0: per part YCoCg sums 0-2, squares 3-5, luminance 6, its square 7;
  * part 0 at 0, part 1 at 8; the count of hits at 16) and the depth gradient zg (the W_ZG row from
- * column xc: max |z_j - z| over the 4 axial hit neighbours), tap by tap (each tap's columns clipped
- * to the block: per pixel, the same sums in the same order as over the whole row) */
+ * column xc: max |z_j - z| over the 4 axial hit neighbours): inside the image each pixel's terms
+ * once per row, then their 3x3 sums (stats_terms, stats_sum9: stats_tap computed a pixel's YCoCg,
+ * squares and products once for each of its 9 neighbours); at the image's edges tap by tap (each
+ * tap's columns clipped to the block). Per pixel, the same sums in the same order either way. */
 static void stats_block(const tctx *c, int y, int xc, int bw, float *S, float *zg)
 {
     int w = (int)c->in->width, hgt = (int)c->in->height;
     size_t row = (size_t)y * w;
-    memset(S, 0, (size_t)S_COUNT * IB * sizeof(float));
     memset(zg, 0, (size_t)bw * sizeof(float));
     float *s[S_COUNT];
     for (int k = 0; k < S_COUNT; ++k) s[k] = S + k * IB;
+    /* rows y -+ 1 in the image: the columns [xl, xh) of the block whose 3 neighbours lie in the image
+     * take each pixel's terms once per row (stats_terms) and their sums (stats_sum9); the image's
+     * first and last column, and the first and last row, go tap by tap */
+    bool rows_in = y >= 1 && y + 1 < hgt;
+    int xl = xc == 0 ? 1 : 0, xh = xc + bw == w ? bw - 1 : bw;
+    if (!rows_in || xh <= xl) xl = xh = 0;
+    memset(S, 0, (size_t)S_COUNT * IB * sizeof(float)); /* sums from 0 */
     const float *Z = plane(c, W_Z) + xc, *H = plane(c, W_HIT) + xc;
     const float *c0 = plane(c, W_CUR) + xc, *c1 = plane(c, W_CUR + 1) + xc, *c2 = plane(c, W_CUR + 2) + xc;
     const float *d0 = plane(c, W_CUR + 3) + xc, *d1 = plane(c, W_CUR + 4) + xc, *d2 = plane(c, W_CUR + 5) + xc;
     const float *L0 = plane(c, W_LUM) + xc, *L1 = plane(c, W_LUM + 1) + xc;
+    if (xh > xl) {
+        float T[3 * 16 * (IB + 2)]; /* rows y - 1, y, y + 1; per row part 0's 8 terms, then part 1's */
+        for (int r = 0; r < 3; ++r) {
+            ptrdiff_t o = (ptrdiff_t)(y - 1 + r) * w + xl - 1; /* from block column xl - 1 */
+            float *t = T + (size_t)r * 16 * (IB + 2);
+            stats_terms(xh - xl + 2, H + o, c0 + o, c1 + o, c2 + o, L0 + o, t);
+            stats_terms(xh - xl + 2, H + o, d0 + o, d1 + o, d2 + o, L1 + o, t + 8 * (IB + 2));
+        }
+        for (int k = 0; k < 16; ++k)
+            stats_sum9(xh - xl, T + (size_t)k * (IB + 2), T + (size_t)(16 + k) * (IB + 2),
+                       T + (size_t)(32 + k) * (IB + 2), s[k] + xl);
+    }
     tap3 taps[9];
-    for (int k = 0, n = row_taps(w, hgt, y, 1, taps); k < n; ++k) {
+    for (int k = 0, nt = row_taps(w, hgt, y, 1, taps); k < nt; ++k) {
         int x0 = taps[k].x0 - xc, x1 = taps[k].x1 - xc; /* block columns */
         x0 = x0 > 0 ? x0 : 0, x1 = x1 < bw ? x1 : bw;
         size_t o = taps[k].o;
         float axial = (taps[k].dx == 0) != (taps[k].dy == 0) ? 1.0f : 0.0f;
-        stats_tap(x0, x1, H + o, c0 + o, c1 + o, c2 + o, L0 + o, s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7]);
-        stats_tap(x0, x1, H + o, d0 + o, d1 + o, d2 + o, L1 + o, s[8], s[9], s[10], s[11], s[12], s[13], s[14], s[15]);
+        for (int e = 0; e < 2; ++e) { /* the columns [x0, x1) outside [xl, xh) */
+            int a = e ? (x0 > xh ? x0 : xh) : x0, b = e ? x1 : (x1 < xl ? x1 : xl);
+            if (b <= a) continue;
+            stats_tap(a, b, H + o, c0 + o, c1 + o, c2 + o, L0 + o, s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7]);
+            stats_tap(a, b, H + o, d0 + o, d1 + o, d2 + o, L1 + o, s[8], s[9], s[10], s[11], s[12], s[13], s[14],
+                      s[15]);
+        }
         count_tap(x0, x1, axial, H + o, Z + o, Z + row, s[16], zg);
     }
 }
