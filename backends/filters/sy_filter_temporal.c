@@ -454,6 +454,18 @@ static void atrous_tap(int x0, int x1, float kk, float zd, const float *restrict
     }
 }
 
+/* one pixel's terms of the clamp's statistics (m: hit 1/0, a: its colour, l: its luminance): its
+ * YCoCg colour v, the squares of v's channels and l, each times m, in t (m v0, m v1, m v2, m v0^2,
+ * m v1^2, m v2^2, m l, m l^2); stats_tap and stats_terms both take them from here */
+static inline SY_TEMPORAL_INLINE void stats_pixel(float m, float a0, float a1, float a2, float l, float *t)
+{
+    float v0 = 0.25f * a0 + 0.5f * a1 + 0.25f * a2, v1 = 0.5f * a0 - 0.5f * a2;
+    float v2 = -0.25f * a0 + 0.5f * a1 - 0.25f * a2;
+    t[0] = m * v0, t[1] = m * v1, t[2] = m * v2;
+    t[3] = m * (v0 * v0), t[4] = m * (v1 * v1), t[5] = m * (v2 * v2);
+    t[6] = m * l, t[7] = m * (l * l);
+}
+
 /* 3x3 statistics of one part, one tap: YCoCg sums s0-s2 and sums of squares s3-s5 of colour a,
  * luminance sum s6 and sum of squares s7, over hits (h = 1) */
 SY_TEMPORAL_CLONES
@@ -463,13 +475,10 @@ static void stats_tap(int x0, int x1, const float *restrict h, const float *rest
                       float *restrict s7)
 {
     for (int x = x0; x < x1; ++x) {
-        float m = h[x];
-        float v0 = 0.25f * a0[x] + 0.5f * a1[x] + 0.25f * a2[x], v1 = 0.5f * a0[x] - 0.5f * a2[x],
-              v2 = -0.25f * a0[x] + 0.5f * a1[x] - 0.25f * a2[x];
-        float l = l0[x];
-        s0[x] += m * v0, s1[x] += m * v1, s2[x] += m * v2;
-        s3[x] += m * (v0 * v0), s4[x] += m * (v1 * v1), s5[x] += m * (v2 * v2);
-        s6[x] += m * l, s7[x] += m * (l * l);
+        float t[8];
+        stats_pixel(h[x], a0[x], a1[x], a2[x], l0[x], t);
+        s0[x] += t[0], s1[x] += t[1], s2[x] += t[2], s3[x] += t[3];
+        s4[x] += t[4], s5[x] += t[5], s6[x] += t[6], s7[x] += t[7];
     }
 }
 
@@ -485,7 +494,7 @@ static void count_tap(int x0, int x1, float axial, const float *restrict h, cons
     }
 }
 
-/* stats_tap's eight terms of one part at columns [0, n) of a row, each once (t: 8 rows of IB + 2
+/* stats_pixel's eight terms of one part at columns [0, n) of a row, each once (t: 8 rows of IB + 2
  * floats: m v0, m v1, m v2, m v0^2, m v1^2, m v2^2, m l, m l^2), for stats_sum9 */
 SY_TEMPORAL_CLONES
 static void stats_terms(int n, const float *restrict h, const float *restrict a0, const float *restrict a1,
@@ -495,13 +504,10 @@ static void stats_terms(int n, const float *restrict h, const float *restrict a0
     float *restrict t0 = t, *restrict t1 = t + TS, *restrict t2 = t + 2 * TS, *restrict t3 = t + 3 * TS;
     float *restrict t4 = t + 4 * TS, *restrict t5 = t + 5 * TS, *restrict t6 = t + 6 * TS, *restrict t7 = t + 7 * TS;
     for (int x = 0; x < n; ++x) {
-        float m = h[x];
-        float v0 = 0.25f * a0[x] + 0.5f * a1[x] + 0.25f * a2[x], v1 = 0.5f * a0[x] - 0.5f * a2[x],
-              v2 = -0.25f * a0[x] + 0.5f * a1[x] - 0.25f * a2[x];
-        float l = l0[x];
-        t0[x] = m * v0, t1[x] = m * v1, t2[x] = m * v2;
-        t3[x] = m * (v0 * v0), t4[x] = m * (v1 * v1), t5[x] = m * (v2 * v2);
-        t6[x] = m * l, t7[x] = m * (l * l);
+        float p[8];
+        stats_pixel(h[x], a0[x], a1[x], a2[x], l0[x], p);
+        t0[x] = p[0], t1[x] = p[1], t2[x] = p[2], t3[x] = p[3];
+        t4[x] = p[4], t5[x] = p[5], t6[x] = p[6], t7[x] = p[7];
     }
 }
 
