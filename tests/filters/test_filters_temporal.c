@@ -114,6 +114,18 @@ static sy_filter_temporal *temporal_open(const sy_filter_temporal_params *p)
     return t;
 }
 
+/* A test of the direct / indirect split: its filter (the defaults on 2 threads; NULL, the failure
+ * counted, when refused) and the two parts' buffers for n pixels (*dir, *ind: 3 floats per pixel,
+ * NULL when out of memory; the caller frees them). */
+static sy_filter_temporal *split_open(size_t n, float **dir, float **ind)
+{
+    sy_filter_temporal_params p;
+    sy_filter_temporal_params_default(&p);
+    p.threads = 2;
+    *dir = malloc(3 * n * sizeof(float)), *ind = malloc(3 * n * sizeof(float));
+    return temporal_open(&p);
+}
+
 /* The end of a test: the filter and the scene freed; 0 (passed) for its return. */
 static int temporal_close(sy_filter_temporal *t, scene *s)
 {
@@ -343,14 +355,11 @@ static int test_rest(void)
 static int test_split(void)
 {
     scene s = {.occluder = true, .rng = 9};
-    sy_filter_temporal_params p;
-    sy_filter_temporal_params_default(&p);
-    p.threads = 2;
-    sy_filter_temporal *t = temporal_open(&p);
-    sy_filter_report err = {0};
     const uint32_t w = 96, h = 64;
     size_t n = (size_t)w * h;
-    float *dir = malloc(3 * n * sizeof(float)), *ind = malloc(3 * n * sizeof(float));
+    float *dir, *ind;
+    sy_filter_temporal *t = split_open(n, &dir, &ind);
+    sy_filter_report err = {0};
     CHECK(t && dir && ind);
     double e_in = 0, e_out = 0, worst_edge = 0, cnt = 0;
     for (int k = 0; k < 12; ++k) {
@@ -583,14 +592,11 @@ static int test_block_symmetry(void)
 static bool sky_run(bool split, float sky, float **out, double *e_in, double *e_out)
 {
     scene s = {.occluder = true, .rng = 21};
-    sy_filter_temporal_params p;
-    sy_filter_temporal_params_default(&p);
-    p.threads = 2;
-    sy_filter_temporal *t = temporal_open(&p);
-    sy_filter_report err = {0};
     const uint32_t w = 100, h = 40;
     size_t n = (size_t)w * h;
-    float *dir = malloc(3 * n * sizeof(float)), *ind = malloc(3 * n * sizeof(float));
+    float *dir, *ind;
+    sy_filter_temporal *t = split_open(n, &dir, &ind);
+    sy_filter_report err = {0};
     *out = malloc(4 * 4 * n * sizeof(float));
     bool through = t && dir && ind && *out;
     for (int k = 0; k < 4 && through; ++k) {
