@@ -912,6 +912,19 @@ static inline bool any_hit(const float *restrict cls, int x0, int x1)
     return any != 0;
 }
 
+/* the columns [x0, x1) of row `row` of each part's colour (3 planes n apart) and variance planes
+ * kept as they are: source PC, PV to destination PD, PDV (misses, any_hit) */
+static void copy_misses(const float *const PC[2], const float *const PV[2], float *const PD[2],
+                        float *const PDV[2], int parts, size_t n, size_t row, int x0, int x1)
+{
+    if (x1 <= x0) return;
+    size_t b = (size_t)(x1 - x0) * sizeof(float);
+    for (int k = 0; k < parts; ++k) {
+        for (int q = 0; q < 3; ++q) memcpy(PD[k] + q * n + row + x0, PC[k] + q * n + row + x0, b);
+        memcpy(PDV[k] + row + x0, PV[k] + row + x0, b);
+    }
+}
+
 /* one a-trous pass (3x3 B-spline, taps c->step apart) over hits, tap by tap over each row;
  * neighbours only of the centre's class (hit with a normal, hit without one); a pixel without a hit
  * keeps its value. With c->two, the direct part (src2 -> dst2) in the same pass. */
@@ -963,27 +976,35 @@ static void atrous_rows(void *vc, uint32_t y0, uint32_t y1)
             atrous_row8((A), (B), s, sw, P[0], P[1], P[2], P[3], P[4], P[5], P[6], P[7], P[8], SN + row,              \
                         PIL[0] + row, IZ + row, o0, o1, o2, ov, c->xmax);                                             \
     } while (0)
+            /* groups of MISS_GROUP columns without a hit keep their source (what the fused loop gives
+             * them, without its taps): a run of them [xm, xr) is copied when the next group with a
+             * hit or the row's end comes, one copy per plane (a copy per group and plane took
+             * longer, in the copy's start-up, than the taps it saved); the runs of groups with a
+             * hit go through the loop */
+            int xm = xa;
             for (int xc = xa; xc < xb; xc += PF_COLS) {
                 int xe = xb - xc > PF_COLS ? xc + PF_COLS : xb, xn = xb - xe > PF_COLS ? xe + PF_COLS : xb;
                 prefetch_cols(PM, nm, 0, xe, xn);
                 prefetch_cols(PN, nn, -s, xe, xn);
                 prefetch_cols(PN, nn, s, xe, xn);
-                /* groups of MISS_GROUP columns without a hit keep their source (what the fused loop
-                 * gives them, without its taps); the runs of groups with one go through the loop */
-                int xr = xc;
+                int xr = xc; /* [xm, xr): misses not yet copied, [xr, g): hits not yet filtered */
                 for (int g = xc; g < xe; g += MISS_GROUP) {
                     int ge = xe - g > MISS_GROUP ? g + MISS_GROUP : xe;
                     if (any_hit(P[0], g, ge)) continue;
-                    if (g > xr) SY_FUSED(xr, g);
-                    for (int k = 0; k < parts; ++k) {
-                        size_t b = (size_t)(ge - g) * sizeof(float);
-                        for (int q = 0; q < 3; ++q) memcpy(PD[k] + q * n + row + g, PC[k] + q * n + row + g, b);
-                        memcpy(PDV[k] + row + g, PV[k] + row + g, b);
+                    if (g > xr) {
+                        SY_FUSED(xr, g);
+                        copy_misses(PC, PV, PD, PDV, parts, n, row, xm, xr);
+                        xm = g;
                     }
                     xr = ge;
                 }
-                if (xe > xr) SY_FUSED(xr, xe);
+                if (xe > xr) {
+                    SY_FUSED(xr, xe);
+                    copy_misses(PC, PV, PD, PDV, parts, n, row, xm, xr);
+                    xm = xe;
+                }
             }
+            copy_misses(PC, PV, PD, PDV, parts, n, row, xm, xb); /* the row's last run of misses */
 #undef SY_FUSED
         }
         for (int k = 0; k < parts; ++k) {
