@@ -734,6 +734,42 @@ static void vblur_tap2(int x0, int x1, float kk, const float *restrict cl, const
     }
 }
 
+/* vblur_tap's 9 taps at once at columns [x0, x1) of a row whose taps all lie in the image (rows
+ * w floats apart; cl, v, vb, vw from the row's start): per pixel the same additions in the same
+ * order (from 0, dy then dx from -1: row_taps's), without 9 passes over the sums */
+SY_TEMPORAL_CLONES
+static void vblur_fused(int x0, int x1, ptrdiff_t w, const float *restrict cl, const float *restrict v,
+                        float *restrict vb, float *restrict vw)
+{
+    for (int x = x0; x < x1; ++x) {
+        float c = cl[x], b = 0.0f, s = 0.0f;
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                ptrdiff_t j = x + dy * w + dx;
+                float k = (dx ? 0.25f : 0.5f) * (dy ? 0.25f : 0.5f) * (float)(cl[j] == c);
+                b += k * v[j], s += k;
+            }
+        vb[x] = b, vw[x] = s;
+    }
+}
+
+/* vblur_fused for both parts (vblur_tap2's taps) */
+SY_TEMPORAL_CLONES
+static void vblur_fused2(int x0, int x1, ptrdiff_t w, const float *restrict cl, const float *restrict v,
+                         const float *restrict v2, float *restrict vb, float *restrict vb2, float *restrict vw)
+{
+    for (int x = x0; x < x1; ++x) {
+        float c = cl[x], b = 0.0f, b2 = 0.0f, s = 0.0f;
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                ptrdiff_t j = x + dy * w + dx;
+                float k = (dx ? 0.25f : 0.5f) * (dy ? 0.25f : 0.5f) * (float)(cl[j] == c);
+                b += k * v[j], b2 += k * v2[j], s += k;
+            }
+        vb[x] = b, vb2[x] = b2, vw[x] = s;
+    }
+}
+
 /* stops_row for both parts: il2 the direct part's luminance stop */
 SY_TEMPORAL_CLONES
 static void stops_row2(int w, float sl, float sz, const float *restrict vw, const float *restrict g,
@@ -762,15 +798,30 @@ static void vblur_row(const tctx *c, int y)
     float sl = P->sigma_luminance, sz = P->sigma_depth * (float)c->step;
     size_t row = (size_t)y * w;
     float *vb = IL + row, *vw = WS + row, *vb2 = plane(c, W_IL2) + row;
-    memset(vb, 0, (size_t)w * sizeof(float));
-    memset(vw, 0, (size_t)w * sizeof(float));
-    if (c->two) memset(vb2, 0, (size_t)w * sizeof(float));
-    tap3 taps[9];
-    for (int k = 0, n = row_taps(w, hgt, y, 1, taps); k < n; ++k) {
-        const tap3 *t = &taps[k];
-        float kk = hk[t->dx + 1] * hk[t->dy + 1];
-        if (c->two) vblur_tap2(t->x0, t->x1, kk, cls + t->o, V + t->o, c->vsrc2 + t->o, cls + row, vb, vb2, vw);
-        else vblur_tap(t->x0, t->x1, kk, cls + t->o, V + t->o, cls + row, vb, vw);
+    /* the columns [xl, xh) whose 9 taps lie in the image in one loop (vblur_fused); the first and
+     * last column, and the rows whose neighbour rows leave the image, tap by tap from 0 */
+    bool rows_in = y >= 1 && y + 1 < hgt;
+    int xl = rows_in && w > 2 ? 1 : 0, xh = rows_in && w > 2 ? w - 1 : 0;
+    if (xh > xl) {
+        if (c->two) vblur_fused2(xl, xh, w, cls + row, V + row, c->vsrc2 + row, vb, vb2, vw);
+        else vblur_fused(xl, xh, w, cls + row, V + row, vb, vw);
+    }
+    for (int e = 0; e < 2; ++e) { /* the columns [0, xl) and [xh, w) */
+        int a = e ? xh : 0, b = e ? w : xl;
+        if (b <= a) continue;
+        size_t nb = (size_t)(b - a) * sizeof(float);
+        memset(vb + a, 0, nb);
+        memset(vw + a, 0, nb);
+        if (c->two) memset(vb2 + a, 0, nb);
+        tap3 taps[9];
+        for (int k = 0, n = row_taps(w, hgt, y, 1, taps); k < n; ++k) {
+            const tap3 *t = &taps[k];
+            float kk = hk[t->dx + 1] * hk[t->dy + 1];
+            int x0 = t->x0 > a ? t->x0 : a, x1 = t->x1 < b ? t->x1 : b;
+            if (x1 <= x0) continue;
+            if (c->two) vblur_tap2(x0, x1, kk, cls + t->o, V + t->o, c->vsrc2 + t->o, cls + row, vb, vb2, vw);
+            else vblur_tap(x0, x1, kk, cls + t->o, V + t->o, cls + row, vb, vw);
+        }
     }
     if (c->two) stops_row2(w, sl, sz, vw, G + row, Z + row, IL + row, vb2, IZ + row);
     else stops_row(w, sl, sz, vw, G + row, Z + row, IL + row, IZ + row);
