@@ -306,6 +306,10 @@ static inline void prefetch_cols(const float *const *p, int k, int off, int x0, 
         for (int r = 0; r < k; ++r) __builtin_prefetch(p[r] + x1 + off - 1); /* the last line */
 }
 
+/* the 3x3 B-spline kernel's 1D weights (the a-trous passes and the variance blur): a tap (dx, dy)
+ * weighs HK[dx + 1] x HK[dy + 1] */
+static const float HK[3] = {0.25f, 0.5f, 0.25f};
+
 /* one tap of a row's 3x3 neighbourhood at step s: its direction (dx, dy), the columns [x0, x1) of
  * the row whose tap lies in the image (tap_span), and o, the offset from a pixel of the row to its
  * tap in a plane */
@@ -746,7 +750,7 @@ static void vblur_fused(int x0, int x1, ptrdiff_t w, const float *restrict cl, c
         for (int dy = -1; dy <= 1; ++dy)
             for (int dx = -1; dx <= 1; ++dx) {
                 ptrdiff_t j = x + dy * w + dx;
-                float k = (dx ? 0.25f : 0.5f) * (dy ? 0.25f : 0.5f) * (float)(cl[j] == c);
+                float k = HK[dx + 1] * HK[dy + 1] * (float)(cl[j] == c);
                 b += k * v[j], s += k;
             }
         vb[x] = b, vw[x] = s;
@@ -763,7 +767,7 @@ static void vblur_fused2(int x0, int x1, ptrdiff_t w, const float *restrict cl, 
         for (int dy = -1; dy <= 1; ++dy)
             for (int dx = -1; dx <= 1; ++dx) {
                 ptrdiff_t j = x + dy * w + dx;
-                float k = (dx ? 0.25f : 0.5f) * (dy ? 0.25f : 0.5f) * (float)(cl[j] == c);
+                float k = HK[dx + 1] * HK[dy + 1] * (float)(cl[j] == c);
                 b += k * v[j], b2 += k * v2[j], s += k;
             }
         vb[x] = b, vb2[x] = b2, vw[x] = s;
@@ -790,7 +794,6 @@ static void stops_row2(int w, float sl, float sz, const float *restrict vw, cons
  * the pass does not write, and its output row is still in the cache when the row is filtered. */
 static void vblur_row(const tctx *c, int y)
 {
-    static const float hk[3] = {0.25f, 0.5f, 0.25f};
     const sy_filter_temporal_params *P = &c->t->p;
     int w = (int)c->in->width, hgt = (int)c->in->height;
     const float *cls = plane(c, W_CLS), *V = c->vsrc, *Z = plane(c, W_Z), *G = plane(c, W_ZG);
@@ -806,6 +809,8 @@ static void vblur_row(const tctx *c, int y)
         if (c->two) vblur_fused2(xl, xh, w, cls + row, V + row, c->vsrc2 + row, vb, vb2, vw);
         else vblur_fused(xl, xh, w, cls + row, V + row, vb, vw);
     }
+    tap3 taps[9];
+    int nt = row_taps(w, hgt, y, 1, taps);
     for (int e = 0; e < 2; ++e) { /* the columns [0, xl) and [xh, w) */
         int a = e ? xh : 0, b = e ? w : xl;
         if (b <= a) continue;
@@ -813,10 +818,9 @@ static void vblur_row(const tctx *c, int y)
         memset(vb + a, 0, nb);
         memset(vw + a, 0, nb);
         if (c->two) memset(vb2 + a, 0, nb);
-        tap3 taps[9];
-        for (int k = 0, n = row_taps(w, hgt, y, 1, taps); k < n; ++k) {
+        for (int k = 0; k < nt; ++k) {
             const tap3 *t = &taps[k];
-            float kk = hk[t->dx + 1] * hk[t->dy + 1];
+            float kk = HK[t->dx + 1] * HK[t->dy + 1];
             int x0 = t->x0 > a ? t->x0 : a, x1 = t->x1 < b ? t->x1 : b;
             if (x1 <= x0) continue;
             if (c->two) vblur_tap2(x0, x1, kk, cls + t->o, V + t->o, c->vsrc2 + t->o, cls + row, vb, vb2, vw);
@@ -981,7 +985,6 @@ static void copy_misses(const float *const PC[2], const float *const PV[2], floa
  * keeps its value. With c->two, the direct part (src2 -> dst2) in the same pass. */
 static void atrous_rows(void *vc, uint32_t y0, uint32_t y1)
 {
-    static const float hk[3] = {0.25f, 0.5f, 0.25f};
     tctx *c = vc;
     size_t n = c->n;
     int w = (int)c->in->width, hgt = (int)c->in->height, s = c->step, parts = c->two ? 2 : 1;
@@ -993,7 +996,7 @@ static void atrous_rows(void *vc, uint32_t y0, uint32_t y1)
     const float *PIL[2] = {plane(c, W_IL), plane(c, W_IL2)};
     float *PD[2] = {c->dst, c->dst2}, *PDV[2] = {c->vdst, c->vdst2};
     float *WS = plane(c, W_WS);
-    const float k0 = hk[1] * hk[1]; /* the centre: exactly its kernel weight */
+    const float k0 = HK[1] * HK[1]; /* the centre: exactly its kernel weight */
     /* the columns whose taps all lie in the image run fused (atrous_row8); the s columns at either
      * edge, and the rows whose neighbour rows y -+ s are not both in the image, tap by tap */
     int xa0 = s < w ? s : w, xb0 = w - s > xa0 ? w - s : xa0;
@@ -1074,7 +1077,7 @@ static void atrous_rows(void *vc, uint32_t y0, uint32_t y1)
                     int x0 = taps[t].x0 > ea ? taps[t].x0 : ea, x1 = taps[t].x1 < eb ? taps[t].x1 : eb;
                     if (x1 <= x0) continue;
                     size_t o = taps[t].o;
-                    float kk = hk[dx + 1] * hk[dy + 1], zd = (dx && dy) ? 0.70710678f : 1.0f;
+                    float kk = HK[dx + 1] * HK[dy + 1], zd = (dx && dy) ? 0.70710678f : 1.0f;
                     atrous_tap(x0, x1, kk, zd, cls + o, Z + o, N0 + o, N1 + o, N2 + o, C0 + o, C1 + o, C2 + o, V + o,
                                cls + row, C0 + row, C1 + row, C2 + row, Z + row, N0 + row, N1 + row, N2 + row,
                                SN + row, IL + row, IZ + row, o0, o1, o2, ow, ov, c->xmax);
