@@ -9,7 +9,8 @@
  * passes' column blocks leave no trace (a mirror-symmetric frame stays symmetric); NaN pixels stay
  * isolated; bad parameters and frames are refused; the a-trous edge-stopping weight stays within
  * its documented bounds of exp; misses (sky) pass through exactly and do not change the hits; the
- * image's edges and its inside, filtered by different loops, give the same pixels. */
+ * image's edges and its inside, filtered by different loops, give the same pixels; the
+ * reprojection's scalar and AVX2 versions give the same values. */
 #include "sy_filter_temporal.h"
 #include "sy_filter_temporal_internal.h"
 #include "synth.h"
@@ -788,6 +789,66 @@ static int test_weight(void)
     return 0;
 }
 
+/* The reprojection's two versions (sy_filter_temporal_reproject_row: the scalar loop and, on a CPU
+ * with AVX2, 8 pixels at a time, with a plain load where a group's 8 taps lie on consecutive history
+ * pixels and gathers elsewhere) give the same values bit for bit. World = pixel coordinates (M the
+ * identity, so a point (x, y, z) lands at pixel (x - 0.5, y - 0.5)); the 64x20 history's pixel
+ * (i, j) sits at (i + 0.5, j + 0.5, 0) with normal +z, its 11 reprojected planes random, a pixel
+ * without a history (length 0) or normal here and there. Rows of 61 points (7 groups of 8, then 5
+ * through the scalar loop): moved by 3.25 columns (every group's taps consecutive), jittered by up to
+ * half a pixel in x and y (consecutive, repeated and skipped columns, two rows in one group), moved
+ * past the left and the right edge, with misses and normals away from +z. */
+static int test_reproject_paths(void)
+{
+    if (!sy_filter_temporal_reproject_avx2()) {
+        printf("  test_reproject_paths: skipped: this CPU has no AVX2 (only the scalar loop runs)\n");
+        return 0;
+    }
+    enum { HW = 64, HH = 20, W = 61, ROWS = 5 };
+    const size_t hn = (size_t)HW * HH + 16, n = W + 3;
+    float *base = calloc(17 * hn, sizeof(float));
+    float *pts = calloc(8 * (size_t)W, sizeof(float));
+    float *ra = calloc(12 * n, sizeof(float)), *rb = calloc(12 * n, sizeof(float));
+    CHECK(base && pts && ra && rb);
+    uint64_t rng = 99;
+    for (size_t j = 0; j < (size_t)HW * HH; ++j) {
+        for (int q = 0; q < 10; ++q) base[q * hn + j] = (float)synth_uniform(&rng);
+        base[10 * hn + j] = synth_uniform(&rng) < 0.05 ? 0.0f : (float)(1 + (int)(synth_uniform(&rng) * 30.0));
+        base[11 * hn + j] = (float)(j % HW) + 0.5f, base[12 * hn + j] = (float)(j / HW) + 0.5f;
+        base[16 * hn + j] = synth_uniform(&rng) < 0.05 ? 0.0f : 1.0f; /* normal +z, or none */
+    }
+    float M[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    float *pa = pts, *pb = pa + W, *pc = pb + W, *na = pc + W, *nb = na + W, *nc = nb + W, *z = nc + W, *h = z + W;
+    int reused[ROWS] = {0};
+    for (int r = 0; r < ROWS; ++r) {
+        for (int x = 0; x < W; ++x) {
+            float y = 7.5f + 0.3f * (float)r;
+            float dx = r == 0 ? 3.25f : r == 3 ? -9.0f : r == 4 ? 9.0f : 0.0f;
+            float jx = r == 1 || r == 2 ? (float)synth_uniform(&rng) - 0.5f : 0.0f;
+            float jy = r == 2 ? (float)synth_uniform(&rng) - 0.5f : 0.0f;
+            pa[x] = (float)x + 0.5f + dx + jx, pb[x] = y + jy, pc[x] = 0.0f;
+            bool miss = r >= 1 && synth_uniform(&rng) < 0.1, tilted = r >= 1 && synth_uniform(&rng) < 0.1;
+            na[x] = tilted ? 0.8f : 0.0f, nb[x] = 0.0f, nc[x] = tilted ? 0.6f : 1.0f;
+            z[x] = 1.0f, h[x] = miss ? 0.0f : 1.0f;
+        }
+        memset(ra, 0xff, 12 * n * sizeof(float)), memset(rb, 0xff, 12 * n * sizeof(float));
+        sy_filter_temporal_reproject_row(false, W, n, M, HW, HH, hn, base, 0.5f, 0.9f, pa, pb, pc, na, nb, nc, z, h, ra,
+                                         ra + 11 * n);
+        sy_filter_temporal_reproject_row(true, W, n, M, HW, HH, hn, base, 0.5f, 0.9f, pa, pb, pc, na, nb, nc, z, h, rb,
+                                         rb + 11 * n);
+        for (int q = 0; q < 12; ++q)
+            CHECK_MSG(memcmp(ra + q * n, rb + q * n, W * sizeof(float)) == 0, "row %d plane %d differs", r, q);
+        for (int x = 0; x < W; ++x) reused[r] += ra[11 * n + x] > 0.0f;
+    }
+    printf("  reprojection, scalar and AVX2 the same; reused per row: %d %d %d %d %d of %d\n", reused[0], reused[1],
+           reused[2], reused[3], reused[4], W);
+    CHECK(reused[0] >= W - 4); /* all but the points past the history's right edge and its few gaps */
+    CHECK(reused[1] > W / 2 && reused[2] > W / 2);
+    CHECK(reused[3] < W - 6 && reused[4] < W - 6); /* the points moved outside find none */
+    free(base), free(pts), free(ra), free(rb);
+    return 0;
+}
+
 int main(void)
 {
     RUN(test_constant_pan);
@@ -802,5 +863,6 @@ int main(void)
     RUN(test_weight);
     RUN(test_sky);
     RUN(test_edge_inside);
+    RUN(test_reproject_paths);
     return sy_check_finish("filters temporal");
 }
