@@ -154,7 +154,7 @@ __attribute__((target("avx2"))) static void reproject_row_avx2(
             __m256i yc = _mm256_min_epi32(_mm256_max_epi32(yy, izero), ihm);
             __m256i j = _mm256_add_epi32(_mm256_mullo_epi32(yc, iw), xc);
             /* the 8 lanes' taps on 8 consecutive history pixels (the view moved little; on the
-             * demo and the Cornell box 60-70 % of the taps): one plain load of the same values
+             * demo and the Cornell box 63-73 % of the taps): one plain load of the same values
              * per plane instead of a gather */
             int jf = _mm256_cvtsi256_si32(j);
             bool run = _mm256_movemask_ps(_mm256_castsi256_ps(
