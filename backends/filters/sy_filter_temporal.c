@@ -12,7 +12,7 @@
  * pixel, the taps are summed in the order the scalar version summed them (centre, then dy, dx
  * row-major), so results do not depend on the vector width or the thread count. The reprojection
  * (4 gathered taps of the previous history per pixel), which GCC does not vectorise, has an AVX2
- * version written with gathers beside the scalar loop (sy_filter_temporal_reproject.c). Passes that
+ * version beside the scalar loop (sy_filter_temporal_reproject.c). Passes that
  * stream the same planes run together: the direct and indirect parts share each variance blur and
  * a-trous pass (atrous_row8_2: the class, depth and normal terms once; the 3x3 statistics of both
  * parts in one loop took more instructions, 31 M against 27 M a frame: the loop's 30 streams spill
@@ -645,8 +645,8 @@ static void blend_row(int w, size_t n, size_t ns, float alpha, float alpha_m, fl
 }
 
 /* depth gradient, reprojection, clamping, moving averages, variance; the next history's geometry:
- * per row the 3x3 statistics (vectorised), the reprojection (scalar: 4 gathered taps per pixel),
- * then blend_row */
+ * per row the 3x3 statistics (vectorised), the reprojection (4 taps of the previous history per
+ * pixel: sy_filter_temporal_reproject_row), then blend_row */
 static void integrate_rows(void *vc, uint32_t y0, uint32_t y1)
 {
     tctx *c = vc;

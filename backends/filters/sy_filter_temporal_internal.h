@@ -78,7 +78,8 @@ bool sy_filter_temporal_reproject_avx2(void);
  * previous world_to_pixel, base its history (hw x hh, 17 planes hn apart: illum 3, dir 3, moments
  * 4, length, position 3, normal 3), dtol / ntol the depth and normal tolerances. Out: R (11 planes n
  * apart: the history, 0 where none fits) and ru (1 where reused). avx2 (from
- * sy_filter_temporal_reproject_avx2): 8 pixels at a time with gathers, the same results. */
+ * sy_filter_temporal_reproject_avx2): 8 pixels at a time (gathers, or plain loads where the 8
+ * pixels' taps lie side by side), the same results. */
 void sy_filter_temporal_reproject_row(bool avx2, int w, size_t n, const float *M, int hw, int hh, size_t hn,
                                       const float *base, float dtol, float ntol, const float *pa, const float *pb,
                                       const float *pc, const float *na, const float *nb, const float *nc,
