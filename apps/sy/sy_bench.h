@@ -25,7 +25,8 @@ sy_result sy_bench_rays(sy_scene *scene, const sy_viewport_desc *vd, uint32_t wi
 sy_result sy_bench_viewports(uint32_t width, uint32_t height, uint32_t repeats, sy_error *err);
 
 /* Rasterizer on OSMesa (or gl=... in vd->params): median frame time of the scene in vd and of a
- * generated 1M-triangle scene (100 meshes) at width x height against the floor (the same buffers
+ * generated 1M-triangle scene (100 meshes; as generated, then written to a .glb and loaded by
+ * sy_cli_load: the user's path) at width x height against the floor (the same buffers
  * drawn with a trivial shader into the same targets), the time from a transform change to the
  * next finished frame, and GL uploads per frame. */
 sy_result sy_bench_raster(sy_scene *scene, const sy_viewport_desc *vd, const char *label, uint32_t width,
@@ -81,10 +82,14 @@ sy_result sy_bench_temporal(sy_scene *scene, const sy_viewport_desc *vd, const c
 /* sy bench instances (sy_bench_instances.c, built with the Embree back-ends): `instances` nodes
  * instancing one height field of about `tris` triangles, rendered with every picture back-end:
  * first frame (translation included), median and worst frame of an orbit of `frames` frames, the
- * rasterizer's triangles drawn and instances culled, coverage IoU against Whitted, peak RSS. `only`
- * (NULL = all): that back-end alone (Whitted still renders its first frame for the IoU). */
+ * rasterizer's triangles drawn and instances culled, coverage IoU against Whitted, peak RSS; for the
+ * scene as generated, then written to a .glb with normals and to one without (positions and indices)
+ * and loaded back by sy_cli_load, with the ratios between the three. `only` (NULL = all): that
+ * back-end alone (Whitted still renders its first frame for the IoU). out_dir (an existing folder)
+ * keeps the two files there as instances.glb and instances_no_normals.glb; NULL: a temporary folder,
+ * removed at the end. */
 sy_result sy_bench_instances(uint32_t instances, uint32_t tris, uint32_t width, uint32_t height, uint32_t frames,
-                             const char *only, sy_error *err);
+                             const char *only, const char *out_dir, sy_error *err);
 /* Distance to the limit (issue 19, part 6; apps/sy/sy_bench_limit.c): one path-traced frame of the
  * view in vd (spp samples per pixel, width x height) is recorded ray by ray, then the frame and raw
  * Embree on exactly those rays (rtcIntersect1/rtcOccluded1, the 4/8/16-wide packets, the 1M

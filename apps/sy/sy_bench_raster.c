@@ -1,8 +1,11 @@
 /* sy_bench_raster.c — `sy bench raster`: the rasterizer's frame against the floor (the same
- * buffers drawn with a trivial shader), transform latency and uploads per frame (see sy_bench.h). */
+ * buffers drawn with a trivial shader), transform latency and uploads per frame (see sy_bench.h),
+ * on the given scene and on a generated one, as generated and through a .glb (the user's path). */
 #include "sy_bench.h"
 
 #include "sy_demo.h"
+#include "sy_gltf_write.h"
+#include "sy_load.h"
 #ifdef SY_HAVE_RASTER
 #include "sy_mediator_raster.h"
 #endif
@@ -11,6 +14,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 /* >>bench raster: our frame against the floor (the same buffers, trivial shader), transform
  * latency and uploads per frame, for one scene. */
@@ -121,6 +125,25 @@ static sy_result bench_raster_scene(const char *label, sy_scene *scene, const sy
 }
 #endif
 
+/* The first node with a mesh under root, first children first (the node the latency line moves in
+ * a loaded copy of the generated scene). */
+#ifdef SY_HAVE_RASTER
+static sy_result first_leaf(const sy_scene *s, sy_node root, sy_node *out, sy_error *err)
+{
+    sy_node n = root;
+    for (uint32_t depth = 0; depth < 64; ++depth) {
+        const sy_node_data *d = sy_node_get(s, n);
+        if (!d) break;
+        if (d->mesh.id) return *out = n, SY_OK;
+        uint32_t count = 0;
+        const uint32_t *kids = sy_node_children(d, &count);
+        if (!count) break;
+        n = (sy_node){kids[0]};
+    }
+    return sy_error_set(err, SY_ERR_NOT_FOUND, "bench raster: no mesh under the loaded scene's first children");
+}
+#endif
+
 /* Adds a point light above the generated scene and a sky background (ambient light). */
 #ifdef SY_HAVE_RASTER
 static sy_result bench_raster_light_scene(sy_scene *s, sy_node root, sy_background *bg_out, sy_error *err)
@@ -157,18 +180,39 @@ sy_result sy_bench_raster(sy_scene *scene, const sy_viewport_desc *vd, const cha
     const char *gl = sy_params_get(&p, "gl");
     printf("sy bench raster: %s\n", gl ? gl : "osmesa");
     r = bench_raster_scene(label, scene, &d, d.root, width, height, repeats, err);
-    /* generated geometry-bound scene: 100 meshes x 10000 triangles */
+    /* generated geometry-bound scene: 100 meshes x 10000 triangles; and the user's path (issue 39):
+     * the same written to a .glb and loaded by sy_cli_load, as sy render loads it */
     sy_scene *s = NULL;
-    sy_node root = {0}, leaf = {0};
+    sy_node root = {0}, leaf = {0}, fleaf = {0};
+    loaded ld = {0};
+    char dir[] = "/tmp/sy_bench_raster_XXXXXX", path[64] = "";
+    bool have_dir = false;
     if (r == SY_OK) r = sy_scene_create(&s, err);
     if (r == SY_OK) r = sy_demo_bench_scene(s, 1, 100, 10000, &root, &leaf, err);
     if (r == SY_OK) r = sy_scene_commit(s, NULL, err);
+    if (r == SY_OK && !(have_dir = mkdtemp(dir) != NULL))
+        r = sy_error_set(err, SY_ERR_IO, "bench raster: cannot create a temporary directory");
+    if (r == SY_OK) {
+        snprintf(path, sizeof path, "%s/generated.glb", dir);
+        r = sy_gltf_write_scene_file(s, root, &(sy_gltf_write_options){.generator = "sy bench raster"}, path, err);
+    }
+    if (r == SY_OK) r = sy_cli_load(path, NULL, false, &ld, err);
+    if (r == SY_OK) r = first_leaf(ld.scene, ld.root, &fleaf, err);
     sy_viewport_desc g = {.root = root, .backend = "raster", .params = d.params};
+    sy_viewport_desc gf = {.root = ld.root, .backend = "raster", .params = d.params};
     if (r == SY_OK) r = bench_raster_scene("generated 1M triangles", s, &g, leaf, width, height, repeats, err);
-    /* the same scene lit (a point light and a sky that gives ambient light): the generated scene
+    if (r == SY_OK)
+        r = bench_raster_scene("the same through a .glb", ld.scene, &gf, fleaf, width, height, repeats, err);
+    /* the same scenes lit (a point light and a sky that gives ambient light): the generated scene
      * has neither, so the lines above shade with the unlit variant (black non-emissive surfaces) */
     if (r == SY_OK) r = bench_raster_light_scene(s, root, &g.background, err);
+    if (r == SY_OK) r = bench_raster_light_scene(ld.scene, ld.root, &gf.background, err);
     if (r == SY_OK) r = bench_raster_scene("generated 1M triangles, lit", s, &g, leaf, width, height, repeats, err);
+    if (r == SY_OK)
+        r = bench_raster_scene("the same through a .glb, lit", ld.scene, &gf, fleaf, width, height, repeats, err);
+    sy_cli_loaded_free(&ld);
+    if (path[0]) unlink(path);
+    if (have_dir) rmdir(dir);
     sy_scene_destroy(s);
     return r;
 #endif

@@ -205,11 +205,12 @@ int sy_cmd_bench(int argc, char **argv)
                    ? 0
                    : sy_cli_fail(&err);
     }
-    if (instanced) {
-        if (optind < argc) return sy_cli_usage_of(who, "no SCENE: the instanced height field is generated");
+    if (instanced) { /* the argument: an existing folder that keeps the scene's two .glb files */
 #ifdef SY_HAVE_EMBREE
         return sy_bench_instances(nodes == 10000 ? 1000 : nodes, tris == 100 ? 1000000 : tris, w == 512 ? 320 : w,
-                                  h == 512 ? 240 : h, repeats ? repeats : 10, backend, &err) == SY_OK ? 0 : sy_cli_fail(&err);
+                                  h == 512 ? 240 : h, repeats ? repeats : 10, backend, scene, &err) == SY_OK
+                   ? 0
+                   : sy_cli_fail(&err);
 #else
         sy_error_set(&err, SY_ERR_UNSUPPORTED, "sy bench instances: this sy was built without the Embree back-ends");
         return sy_cli_fail(&err);

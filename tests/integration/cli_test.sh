@@ -18,8 +18,9 @@
 #     directory is found before anything is rendered; --params with a key twice is a usage error
 #   - typed parameters: sy backends --params (text and --json) lists each back-end's table; an unknown
 #     --params key, a value out of range or not in the enum: status 2 naming it (and the valid keys)
-#   - sy bench sync / sy bench anim / sy bench rays / sy bench governor / sy bench limit on small sizes: exit 0 and
-#     their result lines (no thresholds; bench limit: no replayed answer differs from the frame's), a bad --spp named
+#   - sy bench sync / sy bench anim / sy bench rays / sy bench governor / sy bench limit / sy bench instances on
+#     small sizes: exit 0 and their result lines (no thresholds; bench limit: no replayed answer differs
+#     from the frame's; bench instances: its files read back with what was written), a bad --spp named
 #   - sy demo -o DIR -w 64 -h 36: demo_whitted.png / .exr written
 #   - -b pathtracer: --spp with --aov (EXR with feature channels), --time; --seed (the same twice the same
 #     image, another other noise); a non-EXR --env fails
@@ -365,6 +366,26 @@ run bench_memory_bad "$SY" bench memory -b raster --tris 2000
 [ "$rc" -eq 1 ] && grep -q 'expected one of the ray tracers' "$TMP/bench_memory_bad.err" ||
     fail "bench memory -b raster: status $rc, $(cat "$TMP/bench_memory_bad.err")"
 cat "$TMP/bench_memory.out"
+# bench instances: the generated scene, then the same written to a .glb with normals and to one of
+# positions and indices alone, each loaded back as sy render loads it (4 placements of one shared
+# mesh of 200 triangles); one row per picture back-end and scene, one per back-end in the summary;
+# the temporary files removed
+run_ok "bench instances" bench_instances "$SY" bench instances --nodes 4 --tris 200 -w 32 -h 24 --repeats 2
+for n in yes no; do
+    grep -Eq "^  file with(out)? normals: .*\.glb, [0-9.]+ MB, loaded by sy_cli_load in [0-9.]+ s: 4 placements of 1 mesh, 800 triangles, normals $n\$" \
+        "$TMP/bench_instances.out" || fail "bench instances: no file read back with normals $n"
+done
+nb=$("$SY" backends | grep -Evc ' (analysis|remote)( |$)')
+for sc in generated "file with normals" "file without normals"; do
+    [ "$(grep -Ec "^  [a-z]+ +$sc +[0-9.]+ s +[0-9.]+ ms +[0-9.]+ ms " "$TMP/bench_instances.out")" -eq "$nb" ] ||
+        fail "bench instances: not one row per back-end ($nb) for the scene '$sc'"
+done
+[ "$(grep -Ec '^  [a-z]+ +[0-9.]+x +[0-9.]+x +[0-9.]+x +[0-9.]+x$' "$TMP/bench_instances.out")" -eq "$nb" ] ||
+    fail "bench instances: not one summary row per back-end"
+for f in $(grep -Eo '/[^ ,]*\.glb' "$TMP/bench_instances.out"); do
+    [ ! -e "$f" ] || fail "bench instances: $f left behind"
+done
+cat "$TMP/bench_instances.out"
 # bench governor: one row per picture back-end of the registry (no analysis or remote class), each
 # with its numbers; a bad budget is a usage error
 run_ok "bench governor" bench_governor "$SY" bench governor demo --frames 4 -w 32 -h 24
