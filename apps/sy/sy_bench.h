@@ -40,10 +40,11 @@ sy_result sy_bench_raster(sy_scene *scene, const sy_viewport_desc *vd, const cha
 sy_result sy_bench_load(const char *data_dir, uint32_t tris, uint32_t repeats, sy_error *err);
 
 /* Memory (issue 19): for each ray tracer (backend, or whitted and pathtracer when NULL), a forked
- * child builds a height field of about `tris` unique triangles (sy_height_field_generate, apps/scenes; with glb,
- * the same grid written to a temporary .glb first and loaded by sy_gltf_load) through the normal
- * path (scene blobs -> mediator -> back-end), renders one width x height frame, and reports its
- * peak RSS per triangle with the breakdown: scene, back-end copies, Embree's allocations. */
+ * child builds a height field of about `tris` unique triangles (sy_height_field_generate, apps/scenes)
+ * through the normal path (scene blobs -> mediator -> back-end), renders one width x height frame,
+ * and reports its peak RSS per triangle with the breakdown: scene, back-end copies, Embree's
+ * allocations; then another child the same with the grid written to a temporary .glb and loaded by
+ * sy_gltf_load (the user's path), and the ratio of the two peaks. glb: the file alone. */
 sy_result sy_bench_memory(uint32_t tris, const char *backend, bool glb, uint32_t width, uint32_t height, sy_error *err);
 
 /* Path tracer (issue 3): samples per second (1-spp passes over width x height, median and mean of

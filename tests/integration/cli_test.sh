@@ -357,11 +357,18 @@ cat "$TMP/bench_limit.out"
 mkdir -p "$TMP/o_limit"
 expect_error bench_limit_spp "--spp: '0' is not in 1..1024" "$TMP/o_limit" "$SY" bench limit demo --spp 0
 run_ok "bench memory" bench_memory "$SY" bench memory --tris 2000 -w 16 -h 16
-[ "$(grep -Ec '^  peak RSS +[0-9.]+ MB +[0-9.]+ bytes/triangle' "$TMP/bench_memory.out")" -eq 2 ] ||
-    fail "bench memory: not one peak line per ray tracer"
+[ "$(grep -Ec '^  peak RSS +[0-9.]+ MB +[0-9.]+ bytes/triangle' "$TMP/bench_memory.out")" -eq 4 ] ||
+    fail "bench memory: not one peak line per ray tracer, generated and from the .glb"
+for b in whitted pathtracer; do
+    grep -Eq "^$b, generated: 2048 triangles" "$TMP/bench_memory.out" &&
+        grep -Eq "^$b, from the .glb: 2048 triangles" "$TMP/bench_memory.out" &&
+        grep -Eq "^$b: peak RSS from the .glb / generated [0-9.]+x" "$TMP/bench_memory.out" ||
+        fail "bench memory: $b not measured generated and from the .glb, with their ratio"
+done
 grep -Eq '^  Embree peak .* [0-9.]+ bytes/triangle' "$TMP/bench_memory.out" || fail "bench memory: no Embree line"
 run_ok "bench memory --glb" bench_memory_glb "$SY" bench memory --tris 2000 -b whitted --glb -w 16 -h 16
-grep -Eq '^whitted: 2048 triangles' "$TMP/bench_memory_glb.out" || fail "bench memory --glb: wrong triangle count"
+grep -Eq '^whitted, from the .glb: 2048 triangles' "$TMP/bench_memory_glb.out" &&
+    ! grep -q 'generated:' "$TMP/bench_memory_glb.out" || fail "bench memory --glb: not the file alone, 2048 triangles"
 run bench_memory_bad "$SY" bench memory -b raster --tris 2000
 [ "$rc" -eq 1 ] && grep -q 'expected one of the ray tracers' "$TMP/bench_memory_bad.err" ||
     fail "bench memory -b raster: status $rc, $(cat "$TMP/bench_memory_bad.err")"
