@@ -5,6 +5,7 @@
 #include "sy_bench.h"
 #include "sy_compose.h"
 #include "sy_governor.h"
+#include "sy_gltf_write.h"
 #include "sy_height_field.h"
 #include "sy_orbit.h"
 
@@ -202,7 +203,8 @@ int sy_cmd_bench_governor(int argc, char **argv)
         "  every picture back-end on an orbiting camera (one step per frame) through the frame-time governor:\n"
         "  p50 / p95 frame interval against the budget (default 33 ms), mean resolution scale. Without SCENE:\n"
         "  the glTF Duck (" GOV_DUCK ")\n"
-        "  and a generated height field of T triangles (default 1000000).\n"
+        "  and a generated height field of T triangles (default 1000000), as generated and through a .glb\n"
+        "  loaded as sy render loads it.\n"
         "  --trace: one line per governed frame (size, samples, time)\n";
     enum { O_BUDGET = OPT_OWN_FIRST, O_FRAMES, O_TRIS, O_TRACE };
     const sy_cli_opt opts[] = {SY_CLI_OPT_REAL("budget", O_BUDGET, &o.budget_ms, 1, 10000),
@@ -224,11 +226,31 @@ int sy_cmd_bench_governor(int argc, char **argv)
            o.budget_ms, o.frames, o.width, o.height, GOV_STEP_DEG, sysconf(_SC_NPROCESSORS_ONLN));
     sy_error err = {0};
     sy_result r = SY_OK;
-    for (int k = 0; k < 2 && r == SY_OK; ++k) {
+    char dir[] = "/tmp/sy_bench_governor_XXXXXX", glb[64] = "";
+    for (int k = 0; k < 3 && r == SY_OK; ++k) {
         gov_scene gs = {0};
         loaded ld = {0}; /* a scene file or the demo, as every command loads it (sy_load.h) */
-        if (scene && k == 1) break;
-        if (scene || k == 0) {
+        if (scene && k >= 1) break;
+        if (k == 2) { /* the user's path: the height field written to a .glb and loaded back */
+            sy_scene *hs = NULL;
+            sy_node hf = {0};
+            uint32_t nt = 0;
+            if (!mkdtemp(dir)) {
+                r = sy_error_set(&err, SY_ERR_IO, "bench governor: cannot create a temporary directory");
+                break;
+            }
+            snprintf(glb, sizeof glb, "%s/height_field.glb", dir);
+            r = sy_scene_create(&hs, &err);
+            if (r == SY_OK) r = sy_height_field_generate(hs, tris, &hf, &nt, &err);
+            if (r == SY_OK)
+                r = sy_gltf_write_scene_file(hs, hf, &(sy_gltf_write_options){.generator = "sy bench governor"}, glb,
+                                             &err);
+            sy_scene_destroy(hs);
+            if (r == SY_OK) r = sy_cli_load(glb, NULL, false, &ld, &err);
+            unlink(glb);
+            rmdir(dir);
+            gs.label = "the same through a .glb", gs.scene = ld.scene, gs.root = ld.root, gs.tris = nt;
+        } else if (scene || k == 0) {
             const char *path = scene ? scene : GOV_DUCK;
             gs.label = path;
             if (!scene && access(path, R_OK) != 0) {

@@ -402,6 +402,11 @@ for b in $("$SY" backends | grep -Ev ' (analysis|remote)( |$)' | cut -d' ' -f1);
 done
 ! grep -Eq '^  coverage ' "$TMP/bench_governor.out" || fail "bench governor: an analysis back-end was timed"
 cat "$TMP/bench_governor.out"
+# without SCENE: the generated height field, then the same through a .glb (as many rows each)
+run_ok "bench governor (generated)" bench_governor_gen "$SY" bench governor --frames 2 -w 16 -h 12 --tris 200
+awk '/^generated height field \(200 triangles\)/ {s = 1} /^the same through a .glb \(200 triangles\)/ {s = 2}
+     /^  [a-z]+ +[0-9.]+ +[0-9.]+ / && s {n[s]++} END {exit !(n[1] > 0 && n[1] == n[2])}' \
+    "$TMP/bench_governor_gen.out" || fail "bench governor: not as many rows for the height field through a .glb"
 run bench_governor_bad "$SY" bench governor demo --budget 0
 [ "$rc" -eq 2 ] && grep -q -- "--budget: '0' is not in 1..10000" "$TMP/bench_governor_bad.err" ||
     fail "bench governor --budget 0: status $rc, $(cat "$TMP/bench_governor_bad.err")"
