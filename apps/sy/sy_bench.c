@@ -1,15 +1,19 @@
 /* sy_bench.c — what the `sy bench` benchmarks share (sy_bench.h): the spread of a benchmark's
- * rounds, sorting, the resident set, a timed frame, a back-end that keeps nothing. Each benchmark has its file: sy_bench_sync.c, sy_bench_rays.c,
+ * rounds, sorting, the resident set, a timed frame, a back-end that keeps nothing, a generated
+ * scene through a .glb (the user's path). Each benchmark has its file: sy_bench_sync.c, sy_bench_rays.c,
  * sy_bench_viewports.c, sy_bench_raster.c, sy_bench_load.c, sy_bench_memory.c,
  * sy_bench_pathtracer.c, sy_bench_filters.c, sy_bench_limit.c, sy_bench_instances.c,
  * sy_bench_governor.c, sy_bench_cull.c, sy_bench_web.c, sy_bench_deform.c, sy_bench_anim.c;
  * sy_cmd_bench.c parses the command line. */
 #include "sy_bench.h"
+#include "sy_gltf_write.h"
+#include "sy_load.h"
 #include "sy_mirror.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 int sy_bench_cmp_double(const void *a, const void *b)
@@ -79,4 +83,24 @@ void sy_bench_tube(uint32_t rings, float *pos, float *nrm, uint32_t *j32, uint16
             uint32_t a = i * S + k, c = i * S + (k + 1) % S, *q = idx + 6 * ((size_t)i * S + k);
             q[0] = a, q[1] = a + S, q[2] = c, q[3] = c, q[4] = a + S, q[5] = c + S;
         }
+}
+
+sy_result sy_bench_reload_glb(const sy_scene *s, sy_node root, const char *path, const char *generator,
+                              struct loaded *out, uint64_t *bytes_out, sy_error *err)
+{
+    char dir[] = "/tmp/sy_bench_glb_XXXXXX", tmp[64] = "";
+    if (!path) {
+        if (!mkdtemp(dir)) return sy_error_set(err, SY_ERR_IO, "sy bench: cannot create a temporary directory");
+        snprintf(tmp, sizeof tmp, "%s/scene.glb", dir);
+        path = tmp;
+    }
+    sy_result r = sy_gltf_write_scene_file(s, root, &(sy_gltf_write_options){.generator = generator}, path, err);
+    struct stat st;
+    if (bytes_out) *bytes_out = r == SY_OK && stat(path, &st) == 0 ? (uint64_t)st.st_size : 0;
+    if (r == SY_OK) r = sy_cli_load(path, NULL, false, out, err);
+    if (tmp[0]) {
+        unlink(tmp);
+        rmdir(dir);
+    }
+    return r;
 }

@@ -155,6 +155,14 @@ void sy_bench_tube(uint32_t rings, float *pos, float *nrm, uint32_t *j32, uint16
 /* A .glb with a (grid + 1)^2-vertex grid of 2 * grid^2 triangles: POSITION, NORMAL, TEXCOORD_0,
  * uint32 indices; written through sy_atomic_file (sy bench load, sy bench memory). */
 sy_result sy_bench_write_grid_glb(const char *path, uint32_t grid, sy_error *err);
+/* The user's path for a generated scene (issue 39, part 0): the scene under root written to a .glb
+ * (sy_gltf_write_scene_file) and loaded back by sy_cli_load as `sy render` loads it (no default
+ * camera added) into *out (free it with sy_cli_loaded_free). path: where the file is written and
+ * kept; NULL: a temporary folder, removed with the file once loaded. *bytes_out (may be NULL): the
+ * file's size. Used by sy bench instances, raster and governor. */
+struct loaded;
+sy_result sy_bench_reload_glb(const sy_scene *s, sy_node root, const char *path, const char *generator,
+                              struct loaded *out, uint64_t *bytes_out, sy_error *err);
 /* A benchmark of a back-end this build lacks (SY_WITH_EMBREE / SY_WITH_RASTER off) says so. */
 #define SY_BENCH_WITHOUT(err, what, option)                                                                            \
     return sy_error_set(err, SY_ERR_UNSUPPORTED, "sy bench: %s needs a back-end this sy was built without (%s=OFF)",   \

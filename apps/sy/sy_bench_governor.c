@@ -5,7 +5,6 @@
 #include "sy_bench.h"
 #include "sy_compose.h"
 #include "sy_governor.h"
-#include "sy_gltf_write.h"
 #include "sy_height_field.h"
 #include "sy_orbit.h"
 
@@ -226,7 +225,6 @@ int sy_cmd_bench_governor(int argc, char **argv)
            o.budget_ms, o.frames, o.width, o.height, GOV_STEP_DEG, sysconf(_SC_NPROCESSORS_ONLN));
     sy_error err = {0};
     sy_result r = SY_OK;
-    char dir[] = "/tmp/sy_bench_governor_XXXXXX", glb[64] = "";
     for (int k = 0; k < 3 && r == SY_OK; ++k) {
         gov_scene gs = {0};
         loaded ld = {0}; /* a scene file or the demo, as every command loads it (sy_load.h) */
@@ -235,20 +233,10 @@ int sy_cmd_bench_governor(int argc, char **argv)
             sy_scene *hs = NULL;
             sy_node hf = {0};
             uint32_t nt = 0;
-            if (!mkdtemp(dir)) {
-                r = sy_error_set(&err, SY_ERR_IO, "bench governor: cannot create a temporary directory");
-                break;
-            }
-            snprintf(glb, sizeof glb, "%s/height_field.glb", dir);
             r = sy_scene_create(&hs, &err);
             if (r == SY_OK) r = sy_height_field_generate(hs, tris, &hf, &nt, &err);
-            if (r == SY_OK)
-                r = sy_gltf_write_scene_file(hs, hf, &(sy_gltf_write_options){.generator = "sy bench governor"}, glb,
-                                             &err);
+            if (r == SY_OK) r = sy_bench_reload_glb(hs, hf, NULL, "sy bench governor", &ld, NULL, &err);
             sy_scene_destroy(hs);
-            if (r == SY_OK) r = sy_cli_load(glb, NULL, false, &ld, &err);
-            unlink(glb);
-            rmdir(dir);
             gs.label = "the same through a .glb", gs.scene = ld.scene, gs.root = ld.root, gs.tris = nt;
         } else if (scene || k == 0) {
             const char *path = scene ? scene : GOV_DUCK;

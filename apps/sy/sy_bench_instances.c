@@ -9,7 +9,7 @@
  * matter, the summary gives their ratios. */
 #include "sy_bench.h"
 
-#include "sy_gltf_write.h"
+#include "sy_gltf_write.h" /* sy_gltf_placements_collect */
 #include "sy_height_field.h"
 #include "sy_load.h"
 #include "sy_log.h"
@@ -206,20 +206,19 @@ static const char *ratio_s(char buf[16], double a, double b)
     return buf;
 }
 
-/* One of the .glb files loaded as `sy render` loads it, its shape checked against the generated
- * scene's (the same placements of one shared mesh, the same triangles; normals as written). */
-static sy_result load_file(bench_scene *sc, const char *path, const shape *want, bool normals, sy_error *err)
+/* The generated scene through a .glb at path (sy_bench_reload_glb: written, then loaded as `sy
+ * render` loads it), the loaded shape checked against the generated scene's (the same placements of
+ * one shared mesh, the same triangles; normals as written). */
+static sy_result through_file(bench_scene *sc, const sy_scene *gen, sy_node groot, const char *path, const shape *want,
+                              bool normals, sy_error *err)
 {
+    uint64_t bytes = 0;
     double t0 = sy_time_now();
-    sy_result r = sy_cli_load(path, NULL, false, &sc->ld, err);
+    sy_result r = sy_bench_reload_glb(gen, groot, path, "sy bench instances", &sc->ld, &bytes, err);
     if (r != SY_OK) return r;
-    double load = sy_time_now() - t0;
+    double secs = sy_time_now() - t0;
     sc->s = sc->ld.scene, sc->root = sc->ld.root;
     shape got = {0};
-    long bytes = 0;
-    FILE *f = fopen(path, "rb");
-    if (f && fseek(f, 0, SEEK_END) == 0) bytes = ftell(f);
-    if (f) fclose(f);
     r = scene_shape(sc->s, sc->root, &got, err);
     if (r == SY_OK && (got.placements != want->placements || got.meshes != 1 || got.triangles != want->triangles ||
                        got.normals != normals))
@@ -229,19 +228,15 @@ static sy_result load_file(bench_scene *sc, const char *path, const shape *want,
                             path, got.placements, got.meshes, got.triangles, got.normals ? "yes" : "no",
                             want->placements, want->triangles, normals ? "yes" : "no");
     if (r == SY_OK)
-        printf("  %s: %s, %.1f MB, loaded by sy_cli_load in %.2f s: %u placements of 1 mesh, %.3g triangles, "
-               "normals %s\n", sc->label, path, (double)bytes / 1e6, load, got.placements, got.triangles,
+        printf("  %s: %s, %.1f MB, written and loaded by sy_cli_load in %.2f s: %u placements of 1 mesh, %.3g "
+               "triangles, normals %s\n", sc->label, path, (double)bytes / 1e6, secs, got.placements, got.triangles,
                got.normals ? "yes" : "no");
     return r == SY_OK ? make_camera(sc->s, &sc->cam, err) : r;
 }
 
-/* The generated scene written twice: as it is (positions, normals, UVs), then with the shared mesh
- * reduced to positions and indices. */
-static sy_result write_files(sy_scene *s, sy_node root, const char *const path[2], sy_error *err)
+/* The generated scene's shared mesh reduced to positions and indices (no normals, no UVs). */
+static sy_result strip_normals(sy_scene *s, sy_node root, sy_error *err)
 {
-    sy_gltf_write_options wo = {.generator = "sy bench instances"};
-    sy_result r = sy_gltf_write_scene_file(s, root, &wo, path[0], err);
-    if (r != SY_OK) return r;
     const sy_node_data *rd = sy_node_get(s, root);
     uint32_t nc = 0;
     const uint32_t *kids = rd ? sy_node_children(rd, &nc) : NULL;
@@ -251,8 +246,7 @@ static sy_result write_files(sy_scene *s, sy_node root, const char *const path[2
         return sy_error_set(err, SY_ERR_INVALID_OPERATION, "bench instances: the generated mesh is missing");
     sy_primitive p = md->primitives.items[0];
     p.normals = NULL, p.texcoords0 = NULL;
-    r = sy_mesh_set_primitives(s, kd->mesh, &p, 1, err);
-    return r == SY_OK ? sy_gltf_write_scene_file(s, root, &wo, path[1], err) : r;
+    return sy_mesh_set_primitives(s, kd->mesh, &p, 1, err);
 }
 
 sy_result sy_bench_instances(uint32_t instances, uint32_t tris, uint32_t width, uint32_t height, uint32_t frames,
@@ -286,10 +280,10 @@ sy_result sy_bench_instances(uint32_t instances, uint32_t tris, uint32_t width, 
     snprintf(path[1], sizeof path[1], "%s/instances_no_normals.glb", dir);
     if (r == SY_OK) r = sy_scene_create(&gen, err);
     if (r == SY_OK) r = build(gen, instances, tris, &groot, &mesh_tris, err);
-    if (r == SY_OK) r = write_files(gen, groot, (const char *const[2]){path[0], path[1]}, err);
+    if (r == SY_OK) r = through_file(&sc[1], gen, groot, path[0], &want, true, err);
+    if (r == SY_OK) r = strip_normals(gen, groot, err);
+    if (r == SY_OK) r = through_file(&sc[2], gen, groot, path[1], &want, false, err);
     sy_scene_destroy(gen);
-    if (r == SY_OK) r = load_file(&sc[1], path[0], &want, true, err);
-    if (r == SY_OK) r = load_file(&sc[2], path[1], &want, false, err);
     if (r != SY_OK) goto done;
     /* per back-end the three scenes one after the other, so that a change in the machine's load
      * weighs on the three alike; Whitted first (every scene's coverage reference) */

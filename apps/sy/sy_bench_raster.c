@@ -4,7 +4,6 @@
 #include "sy_bench.h"
 
 #include "sy_demo.h"
-#include "sy_gltf_write.h"
 #include "sy_load.h"
 #ifdef SY_HAVE_RASTER
 #include "sy_mediator_raster.h"
@@ -14,7 +13,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 /* >>bench raster: our frame against the floor (the same buffers, trivial shader), transform
  * latency and uploads per frame, for one scene. */
@@ -185,18 +183,10 @@ sy_result sy_bench_raster(sy_scene *scene, const sy_viewport_desc *vd, const cha
     sy_scene *s = NULL;
     sy_node root = {0}, leaf = {0}, fleaf = {0};
     loaded ld = {0};
-    char dir[] = "/tmp/sy_bench_raster_XXXXXX", path[64] = "";
-    bool have_dir = false;
     if (r == SY_OK) r = sy_scene_create(&s, err);
     if (r == SY_OK) r = sy_demo_bench_scene(s, 1, 100, 10000, &root, &leaf, err);
     if (r == SY_OK) r = sy_scene_commit(s, NULL, err);
-    if (r == SY_OK && !(have_dir = mkdtemp(dir) != NULL))
-        r = sy_error_set(err, SY_ERR_IO, "bench raster: cannot create a temporary directory");
-    if (r == SY_OK) {
-        snprintf(path, sizeof path, "%s/generated.glb", dir);
-        r = sy_gltf_write_scene_file(s, root, &(sy_gltf_write_options){.generator = "sy bench raster"}, path, err);
-    }
-    if (r == SY_OK) r = sy_cli_load(path, NULL, false, &ld, err);
+    if (r == SY_OK) r = sy_bench_reload_glb(s, root, NULL, "sy bench raster", &ld, NULL, err);
     if (r == SY_OK) r = first_leaf(ld.scene, ld.root, &fleaf, err);
     sy_viewport_desc g = {.root = root, .backend = "raster", .params = d.params};
     sy_viewport_desc gf = {.root = ld.root, .backend = "raster", .params = d.params};
@@ -211,8 +201,6 @@ sy_result sy_bench_raster(sy_scene *scene, const sy_viewport_desc *vd, const cha
     if (r == SY_OK)
         r = bench_raster_scene("the same through a .glb, lit", ld.scene, &gf, fleaf, width, height, repeats, err);
     sy_cli_loaded_free(&ld);
-    if (path[0]) unlink(path);
-    if (have_dir) rmdir(dir);
     sy_scene_destroy(s);
     return r;
 #endif

@@ -379,7 +379,7 @@ cat "$TMP/bench_memory.out"
 # the temporary files removed
 run_ok "bench instances" bench_instances "$SY" bench instances --nodes 4 --tris 200 -w 32 -h 24 --repeats 2
 for n in yes no; do
-    grep -Eq "^  file with(out)? normals: .*\.glb, [0-9.]+ MB, loaded by sy_cli_load in [0-9.]+ s: 4 placements of 1 mesh, 800 triangles, normals $n\$" \
+    grep -Eq "^  file with(out)? normals: .*\.glb, [0-9.]+ MB, written and loaded by sy_cli_load in [0-9.]+ s: 4 placements of 1 mesh, 800 triangles, normals $n\$" \
         "$TMP/bench_instances.out" || fail "bench instances: no file read back with normals $n"
 done
 nb=$("$SY" backends | grep -Evc ' (analysis|remote)( |$)')
