@@ -104,3 +104,18 @@ sy_result sy_bench_reload_glb(const sy_scene *s, sy_node root, const char *path,
     }
     return r;
 }
+
+sy_result sy_bench_first_mesh_node(const sy_scene *s, sy_node root, sy_node *out, sy_error *err)
+{
+    sy_node n = root;
+    for (uint32_t depth = 0; depth < 64; ++depth) {
+        const sy_node_data *d = sy_node_get(s, n);
+        if (!d) break;
+        if (d->mesh.id) return *out = n, SY_OK;
+        uint32_t count = 0;
+        const uint32_t *kids = sy_node_children(d, &count);
+        if (!count) break;
+        n = (sy_node){kids[0]};
+    }
+    return sy_error_set(err, SY_ERR_NOT_FOUND, "sy bench: no mesh under the scene's first children");
+}

@@ -163,6 +163,9 @@ sy_result sy_bench_write_grid_glb(const char *path, uint32_t grid, sy_error *err
 struct loaded;
 sy_result sy_bench_reload_glb(const sy_scene *s, sy_node root, const char *path, const char *generator,
                               struct loaded *out, uint64_t *bytes_out, sy_error *err);
+/* The first node with a mesh under root, first children first (in a loaded copy of a generated
+ * scene, the node the generated scene's first leaf became). SY_ERR_NOT_FOUND when there is none. */
+sy_result sy_bench_first_mesh_node(const sy_scene *s, sy_node root, sy_node *out, sy_error *err);
 /* A benchmark of a back-end this build lacks (SY_WITH_EMBREE / SY_WITH_RASTER off) says so. */
 #define SY_BENCH_WITHOUT(err, what, option)                                                                            \
     return sy_error_set(err, SY_ERR_UNSUPPORTED, "sy bench: %s needs a back-end this sy was built without (%s=OFF)",   \

@@ -123,25 +123,6 @@ static sy_result bench_raster_scene(const char *label, sy_scene *scene, const sy
 }
 #endif
 
-/* The first node with a mesh under root, first children first (the node the latency line moves in
- * a loaded copy of the generated scene). */
-#ifdef SY_HAVE_RASTER
-static sy_result first_leaf(const sy_scene *s, sy_node root, sy_node *out, sy_error *err)
-{
-    sy_node n = root;
-    for (uint32_t depth = 0; depth < 64; ++depth) {
-        const sy_node_data *d = sy_node_get(s, n);
-        if (!d) break;
-        if (d->mesh.id) return *out = n, SY_OK;
-        uint32_t count = 0;
-        const uint32_t *kids = sy_node_children(d, &count);
-        if (!count) break;
-        n = (sy_node){kids[0]};
-    }
-    return sy_error_set(err, SY_ERR_NOT_FOUND, "bench raster: no mesh under the loaded scene's first children");
-}
-#endif
-
 /* Adds a point light above the generated scene and a sky background (ambient light). */
 #ifdef SY_HAVE_RASTER
 static sy_result bench_raster_light_scene(sy_scene *s, sy_node root, sy_background *bg_out, sy_error *err)
@@ -187,7 +168,7 @@ sy_result sy_bench_raster(sy_scene *scene, const sy_viewport_desc *vd, const cha
     if (r == SY_OK) r = sy_demo_bench_scene(s, 1, 100, 10000, &root, &leaf, err);
     if (r == SY_OK) r = sy_scene_commit(s, NULL, err);
     if (r == SY_OK) r = sy_bench_reload_glb(s, root, NULL, "sy bench raster", &ld, NULL, err);
-    if (r == SY_OK) r = first_leaf(ld.scene, ld.root, &fleaf, err);
+    if (r == SY_OK) r = sy_bench_first_mesh_node(ld.scene, ld.root, &fleaf, err);
     sy_viewport_desc g = {.root = root, .backend = "raster", .params = d.params};
     sy_viewport_desc gf = {.root = ld.root, .backend = "raster", .params = d.params};
     if (r == SY_OK) r = bench_raster_scene("generated 1M triangles", s, &g, leaf, width, height, repeats, err);

@@ -1,9 +1,10 @@
 /* sy_bench_sync.c — `sy bench sync`: a change to one node of a large generated scene, applied
- * incrementally (commit + sync), against translating the scene from scratch, per back-end
- * (see sy_bench.h). */
+ * incrementally (commit + sync), against translating the scene from scratch, per back-end, on the
+ * scene as generated and written to a .glb and loaded back (the user's path; see sy_bench.h). */
 #include "sy_bench.h"
 
 #include "sy_demo.h"
+#include "sy_load.h"
 #ifdef SY_HAVE_EMBREE
 #include "sy_mediator_rt.h"
 #endif
@@ -111,6 +112,11 @@ sy_result sy_bench_sync(uint32_t nodes, uint32_t tris, uint32_t repeats, sy_erro
         const sy_mesh_data *m = sy_object_get(s, SY_TYPE_MESH, id);
         total_tris += sy_primitive_triangle_count(&m->primitives.items[0]);
     }
+    /* the user's path (issue 39): the same scene written to a .glb and loaded by sy_cli_load */
+    loaded ld = {0};
+    sy_node froot = {0}, fleaf = {0};
+    if (r == SY_OK) r = sy_bench_reload_glb(s, root, NULL, "sy bench sync", &ld, NULL, err);
+    if (r == SY_OK) froot = ld.root, r = sy_bench_first_mesh_node(ld.scene, froot, &fleaf, err);
     size_t log_bytes = 0;
     if (r == SY_OK) {
         printf("sy bench sync: %u nodes (%u groups x %u), %u triangles, %u repeats\n", groups * per_group, groups,
@@ -118,21 +124,32 @@ sy_result sy_bench_sync(uint32_t nodes, uint32_t tris, uint32_t repeats, sy_erro
         printf("  scene build (core)               %9.3f ms\n", t_build * 1e3);
     }
     sync_result sr = {.total = buf, .core = buf + repeats, .embree = buf + 2u * repeats, .ours = buf + 3u * repeats};
+    /* each back-end on the generated scene, then on the same through the .glb */
+    for (int f = 0; f < 2 && r == SY_OK; ++f) {
+        sy_scene *sc = f ? ld.scene : s;
+        sy_node rt = f ? froot : root, lf = f ? fleaf : leaf;
+        const char *via = f ? ", through a .glb" : "";
+        char title[96];
 #ifdef SY_HAVE_EMBREE
-    sr.has_embree = true;
-    if (r == SY_OK) r = bench_sync_backend(s, "whitted", root, leaf, repeats, &log_bytes, &sr, err);
-    if (r == SY_OK) print_sync("whitted (Embree)", &sr, repeats, groups * per_group);
+        sr.has_embree = true;
+        r = bench_sync_backend(sc, "whitted", rt, lf, repeats, f ? NULL : &log_bytes, &sr, err);
+        snprintf(title, sizeof title, "whitted (Embree)%s", via);
+        if (r == SY_OK) print_sync(title, &sr, repeats, groups * per_group);
 #endif
 #ifdef SY_HAVE_RASTER
-    if (r == SY_OK) {
-        sr.has_embree = false;
-        sy_error e2 = {0};
-        sy_result r2 = bench_sync_backend(s, "raster", root, leaf, repeats, log_bytes ? NULL : &log_bytes, &sr, &e2);
-        if (r2 == SY_OK) print_sync("raster (OpenGL)", &sr, repeats, 0);
-        else printf("  raster (OpenGL): skipped: %s\n", e2.message); /* no GL provider here: not an error */
-    }
+        if (r == SY_OK) {
+            sr.has_embree = false;
+            sy_error e2 = {0};
+            sy_result r2 =
+                bench_sync_backend(sc, "raster", rt, lf, repeats, f || log_bytes ? NULL : &log_bytes, &sr, &e2);
+            snprintf(title, sizeof title, "raster (OpenGL)%s", via);
+            if (r2 == SY_OK) print_sync(title, &sr, repeats, 0);
+            else printf("  %s: skipped: %s\n", title, e2.message); /* no GL provider here: not an error */
+        }
 #endif
+    }
     if (r == SY_OK) printf("  change log per change           %10zu bytes\n", log_bytes);
+    sy_cli_loaded_free(&ld);
     sy_scene_destroy(s);
     free(buf);
     return r;
