@@ -2,8 +2,9 @@
 # cull_cli_test.sh SY TMPDIR — `sy bench cull` (ctest cull_cli):
 #   - --write: a 100-object plant written as GLB reads back with `sy info` (100 nodes, each shared
 #     mesh once: the count the generator printed)
-#   - a small run (raster built): exit 0, one row per view, an IoU line whose median lies in 0..1,
-#     drawn triangles within the budget (the budget cut is checked by test_cull; no timing checks)
+#   - a small run (raster built): exit 0, the plant measured through a .glb (the user's path), one
+#     row per view, an IoU line whose median lies in 0..1, drawn triangles within the budget (the
+#     budget cut is checked by test_cull; no timing checks)
 #   - bad values name their option and exit 2
 # SY_TEST_PARTS names the parts this build has; without raster the run is skipped, saying so.
 set -u
@@ -26,6 +27,8 @@ if [[ " ${SY_TEST_PARTS:-} " == *" raster "* ]]; then
     [ $rc -eq 0 ] || fail "bench cull: status $rc: $(cat "$TMP/run.err")"
     rows=$(printf '%s\n' "$out" | grep -cE '^ +[0-9]+ +[0-9]+ +[0-9]+ +[0-9]+ +[0-9]+ +[01]\.[0-9]{4} ')
     [ "$rows" -eq 3 ] || fail "bench cull: $rows view rows, expected 3: $out"
+    printf '%s\n' "$out" | grep -q '^written to a .glb and loaded by sy_cli_load in [0-9.]* s' ||
+        fail "bench cull: the plant did not go through a .glb: $out"
     med=$(printf '%s\n' "$out" | sed -n 's/^coverage IoU.*median \([0-9.]*\).*/\1/p')
     awk -v m="${med:-x}" 'BEGIN { exit !(m ~ /^[0-9.]+$/ && m >= 0 && m <= 1) }' || fail "bench cull: IoU median '$med'"
     drawn=$(printf '%s\n' "$out" | sed -n 's/^triangles drawn by the client: max \([0-9]*\),.*/\1/p')
