@@ -159,7 +159,8 @@ sy_result sy_bench_write_grid_glb(const char *path, uint32_t grid, sy_error *err
  * (sy_gltf_write_scene_file) and loaded back by sy_cli_load as `sy render` loads it (no default
  * camera added) into *out (free it with sy_cli_loaded_free). path: where the file is written and
  * kept; NULL: a temporary folder, removed with the file once loaded. *bytes_out (may be NULL): the
- * file's size. Used by sy bench instances, raster and governor. */
+ * file's size. Used by sy bench instances, raster, sync, governor and cull (sy bench memory writes
+ * its grid with sy_bench_write_grid_glb instead: its children measure the load itself). */
 struct loaded;
 sy_result sy_bench_reload_glb(const sy_scene *s, sy_node root, const char *path, const char *generator,
                               struct loaded *out, uint64_t *bytes_out, sy_error *err);
