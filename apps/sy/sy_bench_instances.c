@@ -33,12 +33,6 @@ static long peak_rss_kib(void)
     return getrusage(RUSAGE_SELF, &ru) == 0 ? ru.ru_maxrss : -1;
 }
 
-static int cmp_d(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
 /* The orbit's camera node (its matrix set per frame by place_camera), not under the root. */
 static sy_result make_camera(sy_scene *s, sy_node *cam, sy_error *err)
 {
@@ -187,7 +181,7 @@ static sy_result run_one(const sy_mediator_class *cls, bench_scene *sc, float ex
     }
 #endif
     if (r == SY_OK && orbit) {
-        qsort(ft, orbit, sizeof *ft, cmp_d);
+        qsort(ft, orbit, sizeof *ft, sy_bench_cmp_double);
         out->p50 = ft[orbit / 2];
         out->max = ft[orbit - 1];
     }
